@@ -1,0 +1,435 @@
+//! The mesh validator behind `--check`: an independent check of a finished mesh against
+//! its input, working on the flat output arrays rather than on the arena.
+//!
+//! For a point set it verifies that the tets are positively oriented, that faces are
+//! shared by at most two tets lying on opposite sides, that the neighbour table agrees,
+//! that the boundary is a closed locally convex surface enclosing the tets' volume with
+//! every input point used (so the tets tile the convex hull), and that every face is
+//! locally Delaunay under the symbolic perturbation.
+
+use crate::geom::{insphere_sos, orient3d, Point, Sign};
+use crate::mesh::FACE_VERTS;
+use crate::output::MeshOut;
+use crate::plc::Plc;
+
+/// Stop collecting after this many problems; the count of the rest is reported.
+const MAX_REPORTED: usize = 20;
+
+struct Problems {
+    list: Vec<String>,
+    more: usize,
+}
+
+impl Problems {
+    fn push(&mut self, msg: String) {
+        if self.list.len() < MAX_REPORTED {
+            self.list.push(msg);
+        } else {
+            self.more += 1;
+        }
+    }
+    fn finish(mut self) -> Result<(), Vec<String>> {
+        if self.more > 0 {
+            self.list
+                .push(format!("... and {} more problems", self.more));
+        }
+        if self.list.is_empty() {
+            Ok(())
+        } else {
+            Err(self.list)
+        }
+    }
+}
+
+/// A face of a tet: sorted vertex key, the tet, and the local face index.
+#[derive(Copy, Clone, PartialEq, Eq, PartialOrd, Ord)]
+struct FaceEntry {
+    key: [u32; 3],
+    tet: u32,
+    face: u8,
+}
+
+/// Checks `mesh` against `plc`; returns the problems found (empty means valid).
+pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
+    let mut pr = Problems {
+        list: Vec::new(),
+        more: 0,
+    };
+    let pts = &mesh.points;
+    let n = pts.len();
+    let base = mesh.first_index;
+    for (i, t) in mesh.tets.iter().enumerate() {
+        let bad_index = t.iter().any(|&v| v as usize >= n);
+        let repeated = (0..4).any(|a| (a + 1..4).any(|b| t[a] == t[b]));
+        if bad_index || repeated {
+            pr.push(format!("tet {} has invalid vertices {:?}", i + base, t));
+        }
+    }
+    if !pr.list.is_empty() {
+        return pr.finish();
+    }
+    let p = |v: u32| -> &Point { &pts[v as usize] };
+    let vol6 = |t: &[u32; 4]| orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+    for (i, t) in mesh.tets.iter().enumerate() {
+        if vol6(t) <= 0.0 {
+            pr.push(format!(
+                "tet {} {:?} is not positively oriented",
+                i + base,
+                shift(t, base)
+            ));
+        }
+    }
+
+    // Pair the faces by sorting; every face must have one or two tets.
+    let mut faces: Vec<FaceEntry> = Vec::with_capacity(mesh.tets.len() * 4);
+    for (i, t) in mesh.tets.iter().enumerate() {
+        for (f, fv) in FACE_VERTS.iter().enumerate() {
+            let mut key = [t[fv[0]], t[fv[1]], t[fv[2]]];
+            key.sort_unstable();
+            faces.push(FaceEntry {
+                key,
+                tet: i as u32,
+                face: f as u8,
+            });
+        }
+    }
+    faces.sort_unstable();
+    let mut boundary: Vec<(u32, u8)> = Vec::new();
+    let mut k = 0;
+    while k < faces.len() {
+        let mut j = k + 1;
+        while j < faces.len() && faces[j].key == faces[k].key {
+            j += 1;
+        }
+        match j - k {
+            1 => boundary.push((faces[k].tet, faces[k].face)),
+            2 => check_interior_face(mesh, faces[k], faces[k + 1], &mut pr),
+            m => pr.push(format!(
+                "face {:?} is shared by {m} tets",
+                faces[k].key.map(|v| v as usize + base)
+            )),
+        }
+        k = j;
+    }
+    drop(faces);
+    check_boundary(mesh, &boundary, &mut pr);
+    check_vertices_used(plc, mesh, &mut pr);
+    pr.finish()
+}
+
+fn shift(t: &[u32], base: usize) -> Vec<usize> {
+    t.iter().map(|&v| v as usize + base).collect()
+}
+
+/// The vertices of face `f` of `t`, oriented with `t[f]` on the positive side.
+fn oriented_face(t: &[u32; 4], f: usize) -> [u32; 3] {
+    let fv = FACE_VERTS[f];
+    [t[fv[0]], t[fv[1]], t[fv[2]]]
+}
+
+fn check_interior_face(mesh: &MeshOut, a: FaceEntry, b: FaceEntry, pr: &mut Problems) {
+    let base = mesh.first_index;
+    let ta = &mesh.tets[a.tet as usize];
+    let tb = &mesh.tets[b.tet as usize];
+    let (fa, fb) = (a.face as usize, b.face as usize);
+    let pts = &mesh.points;
+    // The opposite vertices must lie on opposite sides of the shared face.
+    let f = oriented_face(ta, fa);
+    let e = tb[fb];
+    let side = orient3d(
+        &pts[f[0] as usize],
+        &pts[f[1] as usize],
+        &pts[f[2] as usize],
+        &pts[e as usize],
+    );
+    if side >= 0.0 {
+        pr.push(format!(
+            "tets {} and {} overlap across face {:?}",
+            a.tet as usize + base,
+            b.tet as usize + base,
+            a.key.map(|v| v as usize + base)
+        ));
+        return;
+    }
+    if let Some(nb) = mesh.neighbors.get(a.tet as usize) {
+        if nb[fa] != i64::from(b.tet) || mesh.neighbors[b.tet as usize][fb] != i64::from(a.tet) {
+            pr.push(format!(
+                "neighbour table disagrees at face {:?} of tets {} and {}",
+                a.key.map(|v| v as usize + base),
+                a.tet as usize + base,
+                b.tet as usize + base
+            ));
+        }
+    }
+    if !mesh.plc_mode {
+        let q = [ta[0], ta[1], ta[2], ta[3], e];
+        let s = insphere_sos(q.map(|v| &pts[v as usize]), q);
+        if s != Sign::Negative {
+            pr.push(format!(
+                "face {:?} between tets {} and {} is not locally Delaunay",
+                a.key.map(|v| v as usize + base),
+                a.tet as usize + base,
+                b.tet as usize + base
+            ));
+        }
+    }
+}
+
+/// The boundary must be a closed surface, each edge in two faces with opposite
+/// directions, locally convex, and enclosing exactly the tets' volume.
+fn check_boundary(mesh: &MeshOut, boundary: &[(u32, u8)], pr: &mut Problems) {
+    let base = mesh.first_index;
+    let pts = &mesh.points;
+    let p = |v: u32| -> &Point { &pts[v as usize] };
+    for &(t, f) in boundary {
+        if let Some(nb) = mesh.neighbors.get(t as usize) {
+            if nb[f as usize] != -1 {
+                pr.push(format!(
+                    "tet {} has a neighbour across its boundary face {}",
+                    t as usize + base,
+                    f
+                ));
+            }
+        }
+    }
+    if boundary.is_empty() {
+        if !mesh.tets.is_empty() {
+            pr.push("the mesh has no boundary".into());
+        }
+        return;
+    }
+    // Directed edges (a, b) of the boundary faces, oriented inward, with the face index.
+    let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(boundary.len() * 3);
+    for (idx, &(t, f)) in boundary.iter().enumerate() {
+        let fv = oriented_face(&mesh.tets[t as usize], f as usize);
+        for k in 0..3 {
+            edges.push((fv[k], fv[(k + 1) % 3], idx as u32));
+        }
+    }
+    let mut undirected: Vec<(u32, u32, u32, bool)> = edges
+        .iter()
+        .map(|&(a, b, i)| (a.min(b), a.max(b), i, a < b))
+        .collect();
+    undirected.sort_unstable();
+    let mut k = 0;
+    while k < undirected.len() {
+        let mut j = k + 1;
+        while j < undirected.len()
+            && (undirected[j].0, undirected[j].1) == (undirected[k].0, undirected[k].1)
+        {
+            j += 1;
+        }
+        let (a, b) = (undirected[k].0, undirected[k].1);
+        if j - k != 2 || undirected[k].3 == undirected[k + 1].3 {
+            pr.push(format!(
+                "boundary edge ({}, {}) is in {} boundary faces, not two of opposite sides",
+                a as usize + base,
+                b as usize + base,
+                j - k
+            ));
+        } else if !mesh.plc_mode {
+            let (f1, f2) = (undirected[k].2 as usize, undirected[k + 1].2 as usize);
+            check_hull_edge(mesh, boundary[f1], boundary[f2], pr);
+        }
+        k = j;
+    }
+    // The enclosed volume (divergence theorem) must equal the tets' total volume. Faces
+    // are oriented inward, so each contributes the signed volume of its cone to the origin.
+    let mut enclosed = 0.0;
+    let mut scale = 0.0;
+    let o = [0.0; 3];
+    for &(t, f) in boundary {
+        let fv = oriented_face(&mesh.tets[t as usize], f as usize);
+        let v = orient3d(p(fv[0]), p(fv[1]), p(fv[2]), &o);
+        enclosed += v;
+        scale += v.abs();
+    }
+    let total: f64 = mesh
+        .tets
+        .iter()
+        .map(|t| orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])))
+        .sum();
+    let tol = 1e-9 * (scale + total.abs()) + f64::MIN_POSITIVE;
+    if (enclosed - total).abs() > tol {
+        pr.push(format!(
+            "the boundary encloses volume {} but the tets' volumes sum to {}",
+            enclosed / 6.0,
+            total / 6.0
+        ));
+    }
+}
+
+/// At a hull edge the two hull faces must meet convexly; when they are coplanar, the
+/// hull triangulation there must be Delaunay under the perturbation (TetGen's rule).
+fn check_hull_edge(mesh: &MeshOut, f1: (u32, u8), f2: (u32, u8), pr: &mut Problems) {
+    let base = mesh.first_index;
+    let pts = &mesh.points;
+    let t1 = &mesh.tets[f1.0 as usize];
+    let face1 = oriented_face(t1, f1.1 as usize);
+    let face2 = oriented_face(&mesh.tets[f2.0 as usize], f2.1 as usize);
+    let Some(&x) = face2.iter().find(|v| !face1.contains(v)) else {
+        return;
+    };
+    let p = |v: u32| &pts[v as usize];
+    let o = orient3d(p(face1[0]), p(face1[1]), p(face1[2]), p(x));
+    if o < 0.0 {
+        pr.push(format!(
+            "the boundary is not convex at faces {:?} and {:?}",
+            shift(&face1, base),
+            shift(&face2, base)
+        ));
+    } else if o == 0.0 {
+        let q = [t1[0], t1[1], t1[2], t1[3], x];
+        if insphere_sos(q.map(p), q) != Sign::Negative {
+            pr.push(format!(
+                "coplanar hull faces {:?} and {:?} are not Delaunay",
+                shift(&face1, base),
+                shift(&face2, base)
+            ));
+        }
+    }
+}
+
+/// Every input point must be a mesh vertex unless it duplicates an earlier point.
+fn check_vertices_used(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
+    let base = mesh.first_index;
+    let mut used = vec![false; mesh.points.len()];
+    for t in &mesh.tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut unused: Vec<usize> = (0..plc.points.len().min(used.len()))
+        .filter(|&i| !used[i])
+        .collect();
+    if unused.is_empty() {
+        return;
+    }
+    // An unused point is fine only if an identical point is used.
+    let mut by_coord: Vec<usize> = (0..plc.points.len()).collect();
+    let key = |i: usize| plc.points[i].map(|c| (c + 0.0).to_bits());
+    by_coord.sort_unstable_by_key(|&i| key(i));
+    let mut has_used_twin = vec![false; plc.points.len()];
+    let mut k = 0;
+    while k < by_coord.len() {
+        let mut j = k + 1;
+        while j < by_coord.len() && key(by_coord[j]) == key(by_coord[k]) {
+            j += 1;
+        }
+        let any_used = by_coord[k..j].iter().any(|&i| used[i]);
+        for &i in &by_coord[k..j] {
+            has_used_twin[i] = any_used && !used[i];
+        }
+        k = j;
+    }
+    unused.retain(|&i| !has_used_twin[i]);
+    for i in unused {
+        pr.push(format!(
+            "input point {} is not a vertex of the mesh",
+            i + base
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::options::Options;
+
+    fn cube_with_center() -> Plc {
+        let mut pts: Vec<Point> = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        pts.push([0.4, 0.45, 0.55]);
+        pts.push([0.9, 0.2, 0.3]);
+        Plc::from_points(pts, 0)
+    }
+
+    fn meshed(plc: &Plc) -> MeshOut {
+        crate::tetrahedralize(plc, &Options::default())
+            .unwrap()
+            .mesh
+    }
+
+    #[test]
+    fn a_delaunay_mesh_passes() {
+        let plc = cube_with_center();
+        check_mesh(&plc, &meshed(&plc)).unwrap();
+    }
+
+    #[test]
+    fn an_inverted_tet_fails() {
+        let plc = cube_with_center();
+        let mut m = meshed(&plc);
+        m.tets[0].swap(0, 1);
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(e.contains("not positively oriented"), "{e}");
+    }
+
+    #[test]
+    fn a_missing_tet_fails() {
+        let plc = cube_with_center();
+        let mut m = meshed(&plc);
+        let all_used_before = m.tets.len();
+        m.tets.remove(all_used_before / 2);
+        m.neighbors.clear();
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(e.contains("boundary"), "{e}");
+    }
+
+    #[test]
+    fn a_non_delaunay_face_fails() {
+        // Two tets sharing a face whose opposite vertices see each other inside
+        // their circumspheres: a valid tiling of the hull, but not Delaunay.
+        let pts = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.3, 0.3, 0.05],
+            [0.3, 0.3, -0.05],
+        ];
+        let plc = Plc::from_points(pts.clone(), 0);
+        let orient = |t: [u32; 4]| {
+            let p = |v: u32| &pts[v as usize];
+            if orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) > 0.0 {
+                t
+            } else {
+                [t[1], t[0], t[2], t[3]]
+            }
+        };
+        let m = MeshOut {
+            points: pts.clone(),
+            tets: vec![orient([0, 1, 2, 3]), orient([0, 1, 2, 4])],
+            ..Default::default()
+        };
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(
+            e.contains("not locally Delaunay") || e.contains("not convex"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_unused_point_fails_but_a_duplicate_does_not() {
+        let mut plc = cube_with_center();
+        plc.points.push(plc.points[3]);
+        let m = meshed(&plc);
+        check_mesh(&plc, &m).unwrap();
+        let mut m2 = m.clone();
+        // Pretend point 9 was never inserted: drop every tet that uses it.
+        m2.tets.retain(|t| !t.contains(&9));
+        m2.neighbors.clear();
+        assert!(check_mesh(&plc, &m2).is_err());
+    }
+
+    #[test]
+    fn overlapping_tets_fail() {
+        let plc = cube_with_center();
+        let mut m = meshed(&plc);
+        let t = m.tets[0];
+        m.tets.push(t);
+        m.neighbors.clear();
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(e.contains("shared by"), "{e}");
+    }
+}

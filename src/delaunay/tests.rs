@@ -1,0 +1,195 @@
+use super::*;
+use crate::geom::insphere_sos;
+
+fn lcg(seed: &mut u64) -> f64 {
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn random_points(n: usize, seed: u64) -> Vec<Point> {
+    let mut s = seed;
+    (0..n)
+        .map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)])
+        .collect()
+}
+
+fn grid(nx: usize, ny: usize, nz: usize) -> Vec<Point> {
+    let mut pts = Vec::new();
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                pts.push([x as f64, y as f64, z as f64]);
+            }
+        }
+    }
+    pts
+}
+
+fn sorted_tets(dt: &Delaunay) -> Vec<[u32; 4]> {
+    let mut v: Vec<[u32; 4]> = dt
+        .mesh
+        .real_tets()
+        .map(|t| {
+            let mut x = dt.mesh.verts(t).map(|v| dt.orig[v as usize]);
+            x.sort();
+            x
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// The canonical DT by definition: every non-flat 4-subset whose perturbed
+/// circumsphere contains no other point.
+fn brute_force(pts: &[Point]) -> Vec<[u32; 4]> {
+    let n = pts.len() as u32;
+    let mut out = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            for c in b + 1..n {
+                for d in c + 1..n {
+                    let p = |i: u32| &pts[i as usize];
+                    let o = orient3d(p(a), p(b), p(c), p(d));
+                    if o == 0.0 {
+                        continue;
+                    }
+                    let t = if o > 0.0 { [a, b, c, d] } else { [b, a, c, d] };
+                    let empty = (0..n).filter(|e| !t.contains(e)).all(|e| {
+                        let q = [t[0], t[1], t[2], t[3], e];
+                        insphere_sos(q.map(p), q) == Sign::Negative
+                    });
+                    if empty {
+                        out.push([a, b, c, d]);
+                    }
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn assert_valid(dt: &Delaunay) {
+    dt.mesh.check_links().unwrap();
+    for t in dt.mesh.real_tets() {
+        let v = dt.mesh.verts(t);
+        let p = |i: u32| &dt.points[i as usize];
+        assert!(
+            orient3d(p(v[0]), p(v[1]), p(v[2]), p(v[3])) > 0.0,
+            "tet {v:?} not positive"
+        );
+    }
+}
+
+#[test]
+fn random_points_match_brute_force() {
+    for seed in 1..20 {
+        let pts = random_points(14, seed);
+        let built = Delaunay::build(&pts).unwrap();
+        assert_valid(&built.dt);
+        assert_eq!(sorted_tets(&built.dt), brute_force(&pts), "seed {seed}");
+    }
+}
+
+#[test]
+fn integer_grids_match_the_perturbed_brute_force() {
+    for (nx, ny, nz) in [(2, 2, 2), (3, 2, 2), (3, 3, 2), (3, 3, 3)] {
+        let pts = grid(nx, ny, nz);
+        let built = Delaunay::build(&pts).unwrap();
+        assert_valid(&built.dt);
+        assert_eq!(
+            sorted_tets(&built.dt),
+            brute_force(&pts),
+            "grid {nx}x{ny}x{nz}"
+        );
+    }
+}
+
+#[test]
+fn shuffled_grid_depends_only_on_indices() {
+    // Reversing the index order changes the perturbation, so the DT must follow it.
+    let mut pts = grid(3, 3, 2);
+    pts.reverse();
+    let built = Delaunay::build(&pts).unwrap();
+    assert_valid(&built.dt);
+    assert_eq!(sorted_tets(&built.dt), brute_force(&pts));
+}
+
+#[test]
+fn cospherical_points_match_brute_force() {
+    // Points on a sphere with exactly representable coordinates (Pythagorean quadruples).
+    let mut pts: Vec<Point> = Vec::new();
+    for &(a, b, c) in &[
+        (3.0, 4.0, 12.0),
+        (4.0, 12.0, 3.0),
+        (12.0, 3.0, 4.0),
+        (0.0, 0.0, 13.0),
+    ] {
+        for sx in [-1.0, 1.0] {
+            for sy in [-1.0, 1.0] {
+                pts.push([sx * a, sy * b, c]);
+            }
+        }
+    }
+    pts.push([0.0, 5.0, 12.0]);
+    pts.push([5.0, 0.0, -12.0]);
+    pts.push([0.0, 0.0, -13.0]);
+    pts.push([1.0, 1.0, 1.0]);
+    let built = Delaunay::build(&pts).unwrap();
+    assert_valid(&built.dt);
+    assert_eq!(sorted_tets(&built.dt), brute_force(&pts));
+}
+
+#[test]
+fn duplicates_are_skipped_keeping_the_lowest_index() {
+    let mut pts = random_points(30, 5);
+    pts.push(pts[7]);
+    pts.insert(0, pts[20]); // now point 0 equals point 21
+    let built = Delaunay::build(&pts).unwrap();
+    assert_eq!(built.duplicates, vec![(21, 0), (31, 8)]);
+    let used: std::collections::HashSet<u32> =
+        sorted_tets(&built.dt).into_iter().flatten().collect();
+    assert!(used.contains(&0) && !used.contains(&21) && !used.contains(&31));
+}
+
+#[test]
+fn degenerate_inputs_are_errors() {
+    let coplanar: Vec<Point> = (0..10).map(|i| [i as f64, (i * i) as f64, 0.0]).collect();
+    let e = Delaunay::build(&coplanar).unwrap_err().to_string();
+    assert!(e.contains("coplanar"), "{e}");
+    let collinear: Vec<Point> = (0..10).map(|i| [i as f64, 2.0 * i as f64, 3.0]).collect();
+    let e = Delaunay::build(&collinear).unwrap_err().to_string();
+    assert!(e.contains("collinear"), "{e}");
+    let e = Delaunay::build(&[[0.0; 3]; 5]).unwrap_err().to_string();
+    assert!(e.contains("only 1 distinct"), "{e}");
+    let e = Delaunay::build(&[[0.0, f64::NAN, 0.0]; 5])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("non-finite"), "{e}");
+}
+
+#[test]
+fn larger_random_set_is_valid() {
+    let pts = random_points(3000, 99);
+    let built = Delaunay::build(&pts).unwrap();
+    assert_valid(&built.dt);
+    let dt = &built.dt;
+    for t in dt.mesh.real_tets() {
+        let v = dt.mesh.verts(t);
+        for f in 0..4 {
+            let g = dt.mesh.adj(FaceRef::new(t, f));
+            if dt.mesh.is_ghost(g.tet()) {
+                continue;
+            }
+            let e = dt.mesh.verts(g.tet())[g.face()];
+            let q = [v[0], v[1], v[2], v[3], e];
+            let ids = q.map(|i| dt.orig[i as usize]);
+            assert_eq!(
+                insphere_sos(q.map(|i| &dt.points[i as usize]), ids),
+                Sign::Negative
+            );
+        }
+    }
+}

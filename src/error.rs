@@ -1,0 +1,118 @@
+//! Typed errors of the library; `main.rs` maps them to exit codes.
+
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A problem with an input file: it cannot be read, or its text is malformed.
+#[derive(Debug, Error)]
+pub enum InputError {
+    /// The file could not be opened or read.
+    #[error("{}: {source}", file.display())]
+    Io {
+        /// The file concerned.
+        file: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text of the file is malformed at a given line (1-based).
+    #[error("{}:{line}: {msg}", file.display())]
+    Parse {
+        /// The file concerned.
+        file: PathBuf,
+        /// The 1-based line number, or 0 when the problem is the end of the file.
+        line: usize,
+        /// What is wrong, naming the element.
+        msg: String,
+    },
+    /// The file parsed, but describes an invalid model (not tied to one line).
+    #[error("{}: {msg}", file.display())]
+    Invalid {
+        /// The file concerned.
+        file: PathBuf,
+        /// What is wrong, naming the elements.
+        msg: String,
+    },
+    /// The file's extension names no format we read.
+    #[error("{}: unknown input format (expected .node, .poly, .smesh, .off or .obj)", file.display())]
+    UnknownFormat {
+        /// The file concerned.
+        file: PathBuf,
+    },
+}
+
+impl InputError {
+    /// Builds a parse error at `line` of `file`.
+    pub fn parse(file: &Path, line: usize, msg: impl Into<String>) -> Self {
+        InputError::Parse {
+            file: file.to_path_buf(),
+            line,
+            msg: msg.into(),
+        }
+    }
+
+    /// Builds an I/O error for `file`.
+    pub fn io(file: &Path, source: std::io::Error) -> Self {
+        InputError::Io {
+            file: file.to_path_buf(),
+            source,
+        }
+    }
+}
+
+/// A failure of the meshing algorithms on an input that parsed.
+#[derive(Debug, Error)]
+pub enum MeshError {
+    /// All input points are coplanar, collinear or coincident: no tetrahedron exists.
+    #[error("{0}")]
+    Degenerate(String),
+    /// The input asks for something the mesher cannot do.
+    #[error("{0}")]
+    Unsupported(String),
+    /// An internal consistency check failed; this is a bug.
+    #[error("internal error: {0}")]
+    Internal(String),
+}
+
+/// Any error of the library.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// Bad input file.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// Meshing failed.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// Writing an output file failed.
+    #[error("{}: {source}", file.display())]
+    Output {
+        /// The file being written.
+        file: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Exit code of a successful run.
+pub const EXIT_OK: i32 = 0;
+/// Exit code when meshing failed.
+pub const EXIT_MESH_FAILED: i32 = 1;
+/// Exit code of a usage error (bad or unimplemented switch).
+pub const EXIT_USAGE: i32 = 2;
+/// Exit code of an invalid input model.
+pub const EXIT_INVALID_INPUT: i32 = 3;
+/// Exit code of an I/O error.
+pub const EXIT_IO: i32 = 4;
+
+impl Error {
+    /// The process exit code for this error, as documented in the README.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Input(InputError::Io { .. }) | Error::Output { .. } => EXIT_IO,
+            Error::Input(_) => EXIT_INVALID_INPUT,
+            Error::Mesh(MeshError::Degenerate(_)) => EXIT_INVALID_INPUT,
+            Error::Mesh(_) => EXIT_MESH_FAILED,
+        }
+    }
+}

@@ -1,0 +1,341 @@
+//! Exact orientation and insphere tests (Shewchuk's adaptive predicates via `robust`),
+//! with TetGen's symbolic perturbation to break insphere ties.
+//!
+//! Sign convention: a tet `(a, b, c, d)` is positively oriented when `d` lies on the side
+//! of the plane from which `a, b, c` appear counterclockwise. That is the negation of
+//! Shewchuk's `orient3d`, and it is the orientation of the tets in TetGen's `.ele` files,
+//! so our tets can be written out as they are.
+
+use robust::Coord3D;
+
+/// A point in 3D.
+pub type Point = [f64; 3];
+
+/// The sign of a predicate.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Sign {
+    /// Strictly negative.
+    Negative,
+    /// Exactly zero.
+    Zero,
+    /// Strictly positive.
+    Positive,
+}
+
+impl Sign {
+    /// The sign of a float (which must not be NaN).
+    #[inline]
+    pub fn of(x: f64) -> Sign {
+        if x > 0.0 {
+            Sign::Positive
+        } else if x < 0.0 {
+            Sign::Negative
+        } else {
+            Sign::Zero
+        }
+    }
+
+    /// The opposite sign.
+    #[inline]
+    pub fn flip(self) -> Sign {
+        match self {
+            Sign::Negative => Sign::Positive,
+            Sign::Zero => Sign::Zero,
+            Sign::Positive => Sign::Negative,
+        }
+    }
+}
+
+#[inline(always)]
+fn c(p: &Point) -> Coord3D<f64> {
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// Exact orientation: positive iff `d` lies on the side of plane `abc` from which `a, b, c`
+/// appear counterclockwise (the tet `abcd` is positively oriented); zero iff coplanar.
+/// The sign is always exact; the magnitude is only approximate.
+#[inline]
+pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
+    let (adx, ady, adz) = (a[0] - d[0], a[1] - d[1], a[2] - d[2]);
+    let (bdx, bdy, bdz) = (b[0] - d[0], b[1] - d[1], b[2] - d[2]);
+    let (cdx, cdy, cdz) = (c_[0] - d[0], c_[1] - d[1], c_[2] - d[2]);
+    let det = adz * (bdx * cdy - cdx * bdy)
+        + bdz * (cdx * ady - adx * cdy)
+        + cdz * (adx * bdy - bdx * ady);
+    // Semi-static filter: Shewchuk's first-stage bound (7ε times the permanent), with the
+    // permanent bounded by 6·mx·my·mz from the largest differences per axis.
+    let mx = max3(adx.abs(), bdx.abs(), cdx.abs());
+    let my = max3(ady.abs(), bdy.abs(), cdy.abs());
+    let mz = max3(adz.abs(), bdz.abs(), cdz.abs());
+    let bound = O3D_FILTER * (mx * my * mz);
+    if bound > FILTER_MIN && bound < FILTER_MAX && (det > bound || -det > bound) {
+        return -det;
+    }
+    -robust::orient3d(c(a), c(b), c(c_), c(d))
+}
+
+/// Maximum without `f64::max`'s NaN handling (a NaN here makes the filter fail safe:
+/// every comparison with the bound is false and the exact predicate decides).
+#[inline(always)]
+fn max2(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+#[inline(always)]
+fn max3(a: f64, b: f64, c: f64) -> f64 {
+    max2(max2(a, b), c)
+}
+
+/// 6 · (7 + 56ε)ε, rounded up generously for the rounding of the bound itself.
+const O3D_FILTER: f64 = 5.0e-15;
+/// 4 · 6 · (16 + 224ε)ε, rounded up likewise.
+const ISP_FILTER: f64 = 4.4e-14;
+/// Outside this range the filter's bound may have underflowed or overflowed.
+const FILTER_MIN: f64 = 1e-280;
+const FILTER_MAX: f64 = 1e280;
+
+/// Exact insphere: for a positively oriented tet `abcd`, positive iff `e` lies inside its
+/// circumsphere, negative iff outside, zero iff the five points are cospherical.
+/// The sign is always exact; the magnitude is only approximate.
+#[inline]
+pub fn insphere(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
+    let (aex, aey, aez) = (a[0] - e[0], a[1] - e[1], a[2] - e[2]);
+    let (bex, bey, bez) = (b[0] - e[0], b[1] - e[1], b[2] - e[2]);
+    let (cex, cey, cez) = (c_[0] - e[0], c_[1] - e[1], c_[2] - e[2]);
+    let (dex, dey, dez) = (d[0] - e[0], d[1] - e[1], d[2] - e[2]);
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
+    let abc = aez * bc - bez * ac + cez * ab;
+    let bcd = bez * cd - cez * bd + dez * bc;
+    let cda = cez * da + dez * ac + aez * cd;
+    let dab = dez * ab + aez * bd + bez * da;
+    let alift = aex * aex + aey * aey + aez * aez;
+    let blift = bex * bex + bey * bey + bez * bez;
+    let clift = cex * cex + cey * cey + cez * cez;
+    let dlift = dex * dex + dey * dey + dez * dez;
+    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    // Semi-static filter: Shewchuk's first-stage bound (16ε times the permanent), with
+    // the permanent bounded by 4 · (mx² + my² + mz²) · 6·mx·my·mz.
+    let mx = max2(max2(aex.abs(), bex.abs()), max2(cex.abs(), dex.abs()));
+    let my = max2(max2(aey.abs(), bey.abs()), max2(cey.abs(), dey.abs()));
+    let mz = max2(max2(aez.abs(), bez.abs()), max2(cez.abs(), dez.abs()));
+    let bound = ISP_FILTER * ((mx * mx + my * my + mz * mz) * (mx * my * mz));
+    if bound > FILTER_MIN && bound < FILTER_MAX && (det > bound || -det > bound) {
+        // Shewchuk's positive is inside for his orientation, which is our negative one;
+        // the determinant is alternating, so negating restores our convention.
+        return -det;
+    }
+    -robust::insphere(c(a), c(b), c(c_), c(d), c(e))
+}
+
+/// Insphere with ties broken by TetGen's symbolic perturbation.
+///
+/// `ids` are the points' perturbation indices (input order; Steiner points come later).
+/// Geometrically, each point's lifted height is lowered by an infinitesimal weight that is
+/// larger for lower indices, so the result is the sign of an alternating function of the
+/// five points and the Delaunay tetrahedralization it defines is unique.
+/// Returns `Zero` only if all five points are coplanar (and cocircular).
+pub fn insphere_sos(p: [&Point; 5], ids: [u32; 5]) -> Sign {
+    let det = insphere(p[0], p[1], p[2], p[3], p[4]);
+    if det != 0.0 {
+        return Sign::of(det);
+    }
+    insphere_perturbed(p, ids).flip()
+}
+
+/// The perturbed sign of Shewchuk's (unnegated) insphere when the exact value is zero.
+fn insphere_perturbed(p: [&Point; 5], ids: [u32; 5]) -> Sign {
+    let mut order = [0usize, 1, 2, 3, 4];
+    let mut swaps = 0u32;
+    // Bubble sort: we need the parity of the permutation, and five items are few.
+    for n in (1..5).rev() {
+        for i in 0..n {
+            if ids[order[i]] > ids[order[i + 1]] {
+                order.swap(i, i + 1);
+                swaps += 1;
+            }
+        }
+    }
+    let q = order.map(|k| p[k]);
+    // The coefficient of the weight of the k-th lowest index is (-1)^k times the
+    // orientation of the other four; the lowest index has the dominant weight.
+    for k in 0..5 {
+        let mut rest = [q[0]; 4];
+        let mut j = 0;
+        for (i, pt) in q.iter().enumerate() {
+            if i != k {
+                rest[j] = pt;
+                j += 1;
+            }
+        }
+        let o = robust::orient3d(c(rest[0]), c(rest[1]), c(rest[2]), c(rest[3]));
+        if o != 0.0 {
+            let mut s = Sign::of(o);
+            if k % 2 == 1 {
+                s = s.flip();
+            }
+            if swaps % 2 == 1 {
+                s = s.flip();
+            }
+            return s;
+        }
+    }
+    Sign::Zero
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const A: Point = [0.0, 0.0, 0.0];
+    const B: Point = [1.0, 0.0, 0.0];
+    const C: Point = [0.0, 1.0, 0.0];
+    const D: Point = [0.0, 0.0, 1.0];
+
+    #[test]
+    fn orientation_convention_matches_tetgen() {
+        // d above the counterclockwise triangle abc (seen from +z) is positive.
+        assert!(orient3d(&A, &B, &C, &D) > 0.0);
+        assert!(orient3d(&B, &A, &C, &D) < 0.0);
+        assert_eq!(orient3d(&A, &B, &C, &[0.3, 0.3, 0.0]), 0.0);
+    }
+
+    #[test]
+    fn insphere_inside_and_outside() {
+        assert!(insphere(&A, &B, &C, &D, &[0.2, 0.2, 0.2]) > 0.0);
+        assert!(insphere(&A, &B, &C, &D, &[2.0, 2.0, 2.0]) < 0.0);
+        // (1,1,1) is on the circumsphere of the unit corner tet.
+        assert_eq!(insphere(&A, &B, &C, &D, &[1.0, 1.0, 1.0]), 0.0);
+    }
+
+    #[test]
+    fn exact_on_near_degenerate_input() {
+        // Points that floating-point evaluation gets wrong: a tiny offset from a plane.
+        let e = [0.5, 0.5 + f64::EPSILON, 0.0];
+        let s = orient3d(
+            &[0.0, 0.0, 0.0],
+            &[1.0, 1.0, 0.0],
+            &[1e-300, 1e-300, 1.0],
+            &e,
+        );
+        assert!(s != 0.0);
+        let on = [0.5, 0.5, 0.0];
+        assert_eq!(
+            orient3d(&[0.0, 0.0, 0.0], &[1.0, 1.0, 0.0], &[0.0, 0.0, 1.0], &on),
+            0.0
+        );
+    }
+
+    fn lcg(s: &mut u64) -> f64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*s >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The filtered predicates must agree in sign with the exact ones, also on nearly
+    /// degenerate input where the filter must give up.
+    #[test]
+    fn filters_agree_with_exact_predicates() {
+        let mut s = 7u64;
+        for round in 0..20000 {
+            let mut p: Vec<Point> = (0..5)
+                .map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)])
+                .collect();
+            if round % 2 == 1 {
+                // Put e (nearly) on the sphere / d (nearly) on the plane.
+                let t = lcg(&mut s);
+                let (p0, p1, p2) = (p[0], p[1], p[2]);
+                p[3] = std::array::from_fn(|k| {
+                    p0[k] + t * (p1[k] - p0[k]) + (1.0 - t) * (p2[k] - p0[k])
+                });
+                p[4] = p[0];
+                p[4][0] += f64::EPSILON * (lcg(&mut s) - 0.5);
+            }
+            let scale = [1.0, 1e-100, 1e100, 1e-200][round % 4];
+            let q: Vec<Point> = p.iter().map(|x| x.map(|v| v * scale)).collect();
+            let o = orient3d(&q[0], &q[1], &q[2], &q[3]);
+            let oe = -robust::orient3d(c(&q[0]), c(&q[1]), c(&q[2]), c(&q[3]));
+            assert_eq!(Sign::of(o), Sign::of(oe));
+            let i = insphere(&q[0], &q[1], &q[2], &q[3], &q[4]);
+            let ie = -robust::insphere(c(&q[0]), c(&q[1]), c(&q[2]), c(&q[3]), c(&q[4]));
+            assert_eq!(Sign::of(i), Sign::of(ie));
+        }
+    }
+
+    /// The eight corners of a unit cube are cospherical; every tie must be broken the
+    /// same way whatever the argument order, i.e. the perturbed test is alternating.
+    #[test]
+    fn sos_is_alternating_on_a_cospherical_grid() {
+        let pts: Vec<Point> = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        let mut checked = 0;
+        for a in 0..8u32 {
+            for b in 0..8u32 {
+                for cc in 0..8u32 {
+                    for d in 0..8u32 {
+                        for e in 0..8u32 {
+                            let ids = [a, b, cc, d, e];
+                            let mut uniq = ids.to_vec();
+                            uniq.sort();
+                            uniq.dedup();
+                            if uniq.len() < 5 {
+                                continue;
+                            }
+                            let p = ids.map(|i| &pts[i as usize]);
+                            if orient3d(p[0], p[1], p[2], p[3]) == 0.0 {
+                                continue;
+                            }
+                            let s = insphere_sos(p, ids);
+                            assert_ne!(s, Sign::Zero);
+                            // Swapping two arguments flips the sign.
+                            let q = [p[1], p[0], p[2], p[3], p[4]];
+                            assert_eq!(insphere_sos(q, [b, a, cc, d, e]), s.flip());
+                            // An even permutation keeps it.
+                            let r = [p[1], p[2], p[0], p[3], p[4]];
+                            assert_eq!(insphere_sos(r, [b, cc, a, d, e]), s);
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000);
+    }
+
+    /// On a tie, the query point with the lowest index carries the dominant weight,
+    /// which lowers its lifted companion: it counts as inside the sphere.
+    #[test]
+    fn sos_lowest_index_query_is_inside() {
+        let pts: Vec<Point> = vec![A, B, C, D, [1.0, 1.0, 1.0]];
+        let (b, c_, d, e) = (&pts[1], &pts[2], &pts[3], &pts[4]);
+        let tet = if orient3d(b, c_, d, e) > 0.0 {
+            [1, 2, 3, 4]
+        } else {
+            [2, 1, 3, 4]
+        };
+        let p = [tet[0], tet[1], tet[2], tet[3], 0usize].map(|i| &pts[i]);
+        let ids = [
+            tet[0] as u32,
+            tet[1] as u32,
+            tet[2] as u32,
+            tet[3] as u32,
+            0,
+        ];
+        assert_eq!(insphere(p[0], p[1], p[2], p[3], p[4]), 0.0);
+        assert_eq!(insphere_sos(p, ids), Sign::Positive);
+    }
+}

@@ -1,0 +1,32 @@
+//! Readers of TetGen's input formats and writers of its output files.
+
+pub mod node;
+pub mod obj;
+pub mod off;
+pub mod poly;
+pub mod smesh;
+pub mod tokens;
+pub mod write;
+
+use crate::error::InputError;
+use crate::plc::Plc;
+use std::path::Path;
+
+/// Reads a model, choosing the reader by the file's extension.
+pub fn read_plc(path: &Path) -> Result<Plc, InputError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "node" => node::read(path),
+        "poly" => poly::read(path),
+        "smesh" => smesh::read(path),
+        "off" => off::read(path),
+        "obj" => obj::read(path),
+        _ => Err(InputError::UnknownFormat {
+            file: path.to_path_buf(),
+        }),
+    }
+}

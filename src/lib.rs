@@ -1,0 +1,44 @@
+//! tetcdt: constrained Delaunay tetrahedralizations of piecewise linear complexes,
+//! with exact predicates and TetGen-compatible files.
+//!
+//! Data flows one way: [`io`] reads a [`plc::Plc`], [`delaunay`] builds the canonical
+//! Delaunay tetrahedralization in a [`mesh::Mesh`], and [`io::write`] writes the
+//! resulting [`output::MeshOut`]. [`check`] validates a mesh independently.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod check;
+pub mod delaunay;
+pub mod error;
+pub mod geom;
+pub mod io;
+pub mod mesh;
+pub mod options;
+pub mod output;
+pub mod plc;
+
+pub use error::{Error, InputError, MeshError};
+pub use options::Options;
+pub use output::MeshOut;
+pub use plc::Plc;
+pub mod stats;
+
+pub use stats::Stats;
+
+/// The result of a meshing run: the mesh, its statistics and any warnings for the user.
+#[derive(Clone, Debug, Default)]
+pub struct Meshed {
+    /// The finished mesh.
+    pub mesh: MeshOut,
+    /// Counts and timings.
+    pub stats: Stats,
+    /// Warnings to show the user (duplicate points and the like), one per line.
+    pub warnings: Vec<String>,
+}
+
+/// Meshes a model: the Delaunay tetrahedralization of its points (and, with `-p`, its CDT).
+pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
+    pipeline::run(plc, opts)
+}
+
+mod pipeline;

@@ -1,0 +1,384 @@
+//! The `tetcdt` command: `tetcdt [-switches] FILE`, TetGen style.
+//!
+//! Packed switch strings (`-zQ`, `-pq1.2`) are taken out of the arguments and parsed by
+//! [`tetcdt::options`]; clap handles the rest (`--help`, `--version`, `-o PREFIX`,
+//! `--check` and the input file). Errors are printed as `tetcdt: <error>` on stderr and
+//! exit with the codes of [`tetcdt::error`]: 0 ok, 1 meshing failed, 2 usage, 3 invalid
+//! input, 4 I/O.
+
+use anyhow::anyhow;
+use clap::{ArgAction, Parser};
+use std::ffi::OsString;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use tetcdt::error::{EXIT_MESH_FAILED, EXIT_OK, EXIT_USAGE};
+use tetcdt::io::write::{self as writer, WriteOptions};
+use tetcdt::options::Options;
+
+/// The switches, for `--help`.
+const SWITCHES: &str = "\
+Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
+  -p     Tetrahedralize a piecewise linear complex (.poly, .smesh, .off, .obj) [not implemented yet]
+  -C     Recover facets by cavity retriangulation (the default; needs -p)
+  -F     Recover facets by flips (needs -p)
+  -z     Number all output items from zero
+  -e     Write all edges to the .edge file
+  -n     Write the neighbours of each tet to the .neigh file
+  -f     Write all faces (not only boundary faces) to the .face file
+  -I     No iteration number in output names (cube.node, not cube.1.node)
+  -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
+  -Q     Quiet: no terminal output except errors
+  -V     Verbose: print statistics (-VV for more)
+Other TetGen switches (-q, -a, -A, -r, -Y, -T, -S, -o2, -g, -k, ...) are recognised and refused.
+
+Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
+
+Output: <dir>/<base>.1.node, .ele, .face (and .edge, .neigh) next to the input; an input
+named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically.
+
+Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
+3 invalid input, 4 I/O error.";
+
+/// The options clap sees; packed switch strings are removed beforehand.
+#[derive(Parser, Debug)]
+#[command(
+    name = "tetcdt",
+    version,
+    about = "Constrained Delaunay tetrahedralizations with exact predicates, TetGen-compatible files",
+    override_usage = "tetcdt [-switches] [-o PREFIX] [--check] FILE",
+    after_help = SWITCHES,
+    disable_version_flag = true
+)]
+struct Cli {
+    /// Write PREFIX.node, PREFIX.ele, ... instead of names derived from FILE.
+    #[arg(short = 'o', long = "output", value_name = "PREFIX")]
+    output: Option<PathBuf>,
+    /// Validate the mesh after writing it; exit 1 listing the problems if any.
+    #[arg(long)]
+    check: bool,
+    /// Print the version.
+    #[arg(long, action = ArgAction::Version)]
+    version: Option<bool>,
+    /// The input model: a .node, .poly, .smesh, .off or .obj file.
+    #[arg(value_name = "FILE")]
+    file: PathBuf,
+}
+
+/// A failed run: the exit code and the error to print.
+struct Failure {
+    code: i32,
+    err: anyhow::Error,
+}
+
+impl Failure {
+    fn new(code: i32, err: impl Into<anyhow::Error>) -> Self {
+        Failure {
+            code,
+            err: err.into(),
+        }
+    }
+}
+
+impl From<tetcdt::Error> for Failure {
+    fn from(e: tetcdt::Error) -> Self {
+        Failure::new(e.exit_code(), e)
+    }
+}
+
+/// Progress messages on stdout, unless quiet; write errors (a closed pipe) are ignored.
+struct Say {
+    quiet: bool,
+}
+
+impl Say {
+    fn line(&self, msg: std::fmt::Arguments<'_>) {
+        if !self.quiet {
+            let mut out = std::io::stdout().lock();
+            let _ = out.write_fmt(msg);
+            let _ = out.write_all(b"\n");
+            let _ = out.flush();
+        }
+    }
+}
+
+macro_rules! say {
+    ($s:expr, $($arg:tt)*) => { $s.line(format_args!($($arg)*)) };
+}
+
+/// Splits the arguments (after the program name) into packed switch strings and the
+/// arguments for clap. A switch string is an argument starting with `-` that is not a
+/// long option, `-o` (whose value follows), `-h`, `-` alone, or after `--`.
+fn split_args(args: &[OsString]) -> Result<(Vec<String>, Vec<OsString>), Failure> {
+    let mut switches = Vec::new();
+    let mut rest = Vec::new();
+    let mut iter = args.iter();
+    while let Some(arg) = iter.next() {
+        let bytes = arg.as_encoded_bytes();
+        if bytes == b"--" {
+            rest.push(arg.clone());
+            rest.extend(iter.by_ref().cloned());
+            break;
+        }
+        if bytes == b"-o" || bytes == b"--output" {
+            rest.push(arg.clone());
+            if let Some(value) = iter.next() {
+                rest.push(value.clone());
+            }
+            continue;
+        }
+        if bytes.starts_with(b"--") || bytes == b"-h" || bytes == b"-" || !bytes.starts_with(b"-") {
+            rest.push(arg.clone());
+            continue;
+        }
+        match arg.to_str() {
+            Some(s) => switches.push(s.to_owned()),
+            None => {
+                return Err(Failure::new(
+                    EXIT_USAGE,
+                    anyhow!("switch string {arg:?} is not valid UTF-8"),
+                ))
+            }
+        }
+    }
+    Ok((switches, rest))
+}
+
+/// Parses the command line into options and the input file. `Ok(None)` means that
+/// clap printed help or the version.
+fn parse_args(args: &[OsString]) -> Result<Option<(Options, PathBuf)>, Failure> {
+    let (switches, rest) = split_args(args)?;
+    let cli = match Cli::try_parse_from(std::iter::once(OsString::from("tetcdt")).chain(rest)) {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return Ok(None);
+            }
+            let text = e.render().to_string();
+            let text = text
+                .strip_prefix("error: ")
+                .unwrap_or(&text)
+                .trim_end()
+                .to_owned();
+            return Err(Failure::new(EXIT_USAGE, anyhow!(text)));
+        }
+    };
+    let mut opts = Options::from_switches(switches.iter().map(String::as_str))
+        .map_err(|e| Failure::new(EXIT_USAGE, anyhow!("{e} (see tetcdt --help)")))?;
+    opts.output = cli.output;
+    opts.check = cli.check;
+    Ok(Some((opts, cli.file)))
+}
+
+/// Runs the command; returns the exit code of a successful or help run.
+fn run(args: Vec<OsString>) -> Result<i32, Failure> {
+    let start = Instant::now();
+    let Some((opts, file)) = parse_args(&args)? else {
+        return Ok(EXIT_OK);
+    };
+    let say = Say { quiet: opts.quiet };
+
+    // Name the outputs first, so that a naming problem costs no meshing time.
+    let mut wopts = WriteOptions::from_options(&opts);
+    let prefix = writer::output_prefix(&file, opts.output.as_deref(), opts.no_iteration)
+        .map_err(|e| Failure::new(EXIT_USAGE, e))?;
+    let outputs: Vec<PathBuf> = writer::file_kinds(opts.plc, &wopts)
+        .into_iter()
+        .map(|k| writer::output_path(&prefix, k))
+        .collect();
+    writer::check_outputs_spare_input(&file, &outputs).map_err(|e| Failure::new(EXIT_USAGE, e))?;
+    writer::check_output_dir(&prefix)?;
+
+    say!(say, "Opening {}.", file.display());
+    let plc = tetcdt::io::read_plc(&file).map_err(tetcdt::Error::from)?;
+
+    if opts.plc {
+        say!(say, "Constrained Delaunay tetrahedralization...");
+    } else {
+        say!(say, "Delaunizing vertices...");
+    }
+    let meshed = tetcdt::tetrahedralize(&plc, &opts)?;
+    say!(say, "Delaunay seconds:  {}", meshed.stats.delaunay_secs);
+    if !opts.quiet {
+        let mut err = std::io::stderr().lock();
+        for w in &meshed.warnings {
+            let _ = writeln!(err, "Warning: {w}");
+        }
+    }
+
+    let out_start = Instant::now();
+    say!(say, "");
+    wopts.comment = Some(generated_by(&args));
+    writer::write_files(&meshed.mesh, &prefix, &wopts, &mut |p: &Path| {
+        say!(say, "Writing {}.", p.display());
+    })?;
+    say!(say, "");
+    say!(
+        say,
+        "Output seconds:  {}",
+        out_start.elapsed().as_secs_f64()
+    );
+    say!(
+        say,
+        "Total running seconds:  {}",
+        start.elapsed().as_secs_f64()
+    );
+
+    if opts.verbose > 0 {
+        let s = &meshed.stats;
+        say!(say, "");
+        say!(say, "Statistics:");
+        say!(say, "");
+        say!(say, "  Input points: {}", s.input_points);
+        say!(say, "  Duplicate points: {}", s.duplicate_points);
+        say!(say, "");
+        say!(say, "  Mesh points: {}", meshed.mesh.points.len());
+        say!(say, "  Mesh tetrahedra: {}", s.output_tets);
+        say!(say, "  Convex hull faces: {}", s.hull_faces);
+        say!(say, "");
+        say!(say, "  Sorting seconds: {}", s.sort_secs);
+        say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
+        say!(say, "  Meshing seconds: {}", s.total_secs);
+    }
+
+    if opts.check {
+        say!(say, "");
+        say!(say, "Checking the mesh...");
+        if let Err(problems) = tetcdt::check::check_mesh(&plc, &meshed.mesh) {
+            return Err(check_failure(&problems));
+        }
+        say!(say, "Mesh check passed.");
+    }
+    Ok(EXIT_OK)
+}
+
+/// The failure of `--check`: every problem, one per line.
+fn check_failure(problems: &[String]) -> Failure {
+    let mut msg = format!("mesh check failed with {} problem(s):", problems.len());
+    for p in problems {
+        msg.push_str("\n  ");
+        msg.push_str(p);
+    }
+    Failure::new(EXIT_MESH_FAILED, anyhow!(msg))
+}
+
+/// The text of the comment line closing the output files.
+fn generated_by(args: &[OsString]) -> String {
+    let mut s = String::from("Generated by tetcdt");
+    for a in args {
+        s.push(' ');
+        s.push_str(&a.to_string_lossy());
+    }
+    s
+}
+
+/// The error and its causes, joined by ": ", skipping a cause whose text the message
+/// already ends with (errors that print their source themselves).
+fn error_chain(err: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if msg.is_empty() {
+            msg = text;
+        } else if !msg.ends_with(&text) {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
+    }
+    msg
+}
+
+fn main() {
+    // A panic is a bug: report it as an internal error (exit 1), never as a crash.
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        let _ = writeln!(std::io::stderr(), "tetcdt: internal error: {msg}{at}");
+    }));
+    let args: Vec<OsString> = std::env::args_os().skip(1).collect();
+    let code = match std::panic::catch_unwind(move || run(args)) {
+        Ok(Ok(code)) => code,
+        Ok(Err(f)) => {
+            let _ = writeln!(std::io::stderr(), "tetcdt: {}", error_chain(&f.err));
+            f.code
+        }
+        Err(_) => EXIT_MESH_FAILED,
+    };
+    std::process::exit(code);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn os(v: &[&str]) -> Vec<OsString> {
+        v.iter().map(OsString::from).collect()
+    }
+
+    #[test]
+    fn switch_strings_are_split_from_clap_arguments() {
+        let (sw, rest) = split_args(&os(&[
+            "-zQ", "f.node", "-o", "-weird", "--check", "-V", "-h", "-", "--", "-x",
+        ]))
+        .ok()
+        .unwrap();
+        assert_eq!(sw, ["-zQ", "-V"]);
+        assert_eq!(
+            rest,
+            os(&["f.node", "-o", "-weird", "--check", "-h", "-", "--", "-x"])
+        );
+        let (sw, rest) = split_args(&os(&["--output", "-p", "-p", "--output=x"]))
+            .ok()
+            .unwrap();
+        assert_eq!(sw, ["-p"]);
+        assert_eq!(rest, os(&["--output", "-p", "--output=x"]));
+    }
+
+    #[test]
+    fn parsed_arguments() {
+        let (opts, file) = parse_args(&os(&["m.node", "-fe", "-o", "out/x", "--check"]))
+            .ok()
+            .unwrap()
+            .unwrap();
+        assert_eq!(file, PathBuf::from("m.node"));
+        assert!(opts.all_faces && opts.write_edges && opts.check);
+        assert_eq!(opts.output, Some(PathBuf::from("out/x")));
+        let f = parse_args(&os(&["-q", "m.node"])).err().unwrap();
+        assert_eq!(f.code, EXIT_USAGE);
+        assert!(error_chain(&f.err).contains("switch -q (quality"));
+        let f = parse_args(&os(&[])).err().unwrap();
+        assert_eq!(f.code, EXIT_USAGE);
+    }
+
+    #[test]
+    fn error_chains_skip_repeated_causes() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "gone");
+        let e = tetcdt::Error::Output {
+            file: PathBuf::from("a.node"),
+            source: io,
+        };
+        assert_eq!(error_chain(&anyhow::Error::new(e)), "a.node: gone");
+        let e = anyhow!("inner").context("outer");
+        assert_eq!(error_chain(&e), "outer: inner");
+    }
+
+    #[test]
+    fn check_failures_list_every_problem() {
+        let f = check_failure(&["tet 3 is inverted".into(), "face 7 is not Delaunay".into()]);
+        assert_eq!(f.code, EXIT_MESH_FAILED);
+        assert_eq!(
+            error_chain(&f.err),
+            "mesh check failed with 2 problem(s):\n  tet 3 is inverted\n  face 7 is not Delaunay"
+        );
+    }
+}

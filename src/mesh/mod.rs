@@ -1,0 +1,305 @@
+//! The tetrahedral mesh: a flat arena of tets, each with four vertices and four
+//! neighbour links, and a ghost vertex closing the hull. Pure combinatorics: no
+//! coordinates live here.
+//!
+//! Conventions:
+//! - Face `i` of a tet is the face opposite its vertex `v[i]`.
+//! - `adj[i]` is a [`FaceRef`]: the neighbour across face `i` *and* which of the
+//!   neighbour's faces is glued to ours, so gluing and flipping need no search.
+//! - Hull tets carry [`GHOST`] in slot 3; their face 3 is a hull face. So every face of
+//!   every real tet has a neighbour, and insertion has no boundary cases.
+//! - Ids are `u32`: a [`FaceRef`] packs `tet << 2 | face` and so addresses 2^32 face
+//!   slots (2^30 tets); index arithmetic is done in `usize`, and growth past that
+//!   limit is refused rather than wrapped.
+
+/// A vertex id: an index into the point array, or [`GHOST`].
+pub type VertexId = u32;
+/// A tet id: an index into the arena.
+pub type TetId = u32;
+
+/// The ghost vertex, "at infinity", closing the hull.
+pub const GHOST: VertexId = u32::MAX;
+/// Marks a tet slot that is free (its `v[0]` is set to this).
+const DEAD: VertexId = u32::MAX;
+/// The largest number of tet slots a [`FaceRef`] can address.
+pub const MAX_TETS: usize = 1 << 30;
+
+/// For face `i`, three local indices `(a, b, c)` such that `(a, b, c, i)` is an even
+/// permutation of `(0, 1, 2, 3)`: the face seen with `v[i]` on its positive side.
+pub const FACE_VERTS: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+
+/// A reference to one face of one tet: `tet << 2 | face`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FaceRef(pub u32);
+
+impl FaceRef {
+    /// The reference to face `face` of tet `tet`.
+    #[inline(always)]
+    pub fn new(tet: TetId, face: usize) -> Self {
+        FaceRef((tet << 2) | face as u32)
+    }
+    /// The tet.
+    #[inline(always)]
+    pub fn tet(self) -> TetId {
+        self.0 >> 2
+    }
+    /// The face index within the tet (0..4).
+    #[inline(always)]
+    pub fn face(self) -> usize {
+        (self.0 & 3) as usize
+    }
+}
+
+/// A tetrahedron: four vertices and, for each face, the glued face of the neighbour.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct Tet {
+    /// Vertices; positively oriented (see `geom::predicates`); `GHOST` only in slot 3.
+    pub v: [VertexId; 4],
+    /// `adj[i]` is the neighbour's face glued to our face `i`.
+    pub adj: [FaceRef; 4],
+}
+
+/// The tet arena with a free list and a vertex-to-tet map.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    tets: Vec<Tet>,
+    free: Vec<TetId>,
+    /// For each vertex, some live tet incident to it (or `u32::MAX`).
+    vert_tet: Vec<TetId>,
+}
+
+/// Error when the arena would exceed [`MAX_TETS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TooManyTets;
+
+impl Mesh {
+    /// An empty mesh for `num_vertices` vertices.
+    pub fn new(num_vertices: usize) -> Self {
+        Mesh {
+            tets: Vec::new(),
+            free: Vec::new(),
+            vert_tet: vec![u32::MAX; num_vertices],
+        }
+    }
+
+    /// Reserves room for about `n` tets.
+    pub fn reserve(&mut self, n: usize) {
+        self.tets.reserve(n.min(MAX_TETS));
+    }
+
+    /// Makes room for vertices up to `num_vertices` (for Steiner points).
+    pub fn grow_vertices(&mut self, num_vertices: usize) {
+        if self.vert_tet.len() < num_vertices {
+            self.vert_tet.resize(num_vertices, u32::MAX);
+        }
+    }
+
+    /// The tet `t`.
+    #[inline(always)]
+    pub fn tet(&self, t: TetId) -> &Tet {
+        &self.tets[t as usize]
+    }
+
+    /// The vertices of tet `t`.
+    #[inline(always)]
+    pub fn verts(&self, t: TetId) -> [VertexId; 4] {
+        self.tets[t as usize].v
+    }
+
+    /// The face glued to face `f`.
+    #[inline(always)]
+    pub fn adj(&self, f: FaceRef) -> FaceRef {
+        self.tets[f.tet() as usize].adj[f.face()]
+    }
+
+    /// True if `t` is a hull (ghost) tet.
+    #[inline(always)]
+    pub fn is_ghost(&self, t: TetId) -> bool {
+        self.tets[t as usize].v[3] == GHOST
+    }
+
+    /// True if slot `t` holds a live tet.
+    #[inline(always)]
+    pub fn is_alive(&self, t: TetId) -> bool {
+        (t as usize) < self.tets.len() && self.tets[t as usize].v[0] != DEAD
+    }
+
+    /// The number of slots (live and free).
+    pub fn num_slots(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Some live tet incident to vertex `v`, if any.
+    pub fn vertex_tet(&self, v: VertexId) -> Option<TetId> {
+        self.vert_tet
+            .get(v as usize)
+            .copied()
+            .filter(|&t| t != u32::MAX)
+    }
+
+    /// Creates a tet with vertices `v` and unset links; reuses a free slot if any.
+    #[inline]
+    pub fn add_tet(&mut self, v: [VertexId; 4]) -> Result<TetId, TooManyTets> {
+        let tet = Tet {
+            v,
+            adj: [FaceRef(u32::MAX); 4],
+        };
+        let t = match self.free.pop() {
+            Some(t) => {
+                self.tets[t as usize] = tet;
+                t
+            }
+            None => {
+                if self.tets.len() >= MAX_TETS {
+                    return Err(TooManyTets);
+                }
+                self.tets.push(tet);
+                (self.tets.len() - 1) as TetId
+            }
+        };
+        Ok(t)
+    }
+
+    /// Points every vertex at one of its live tets. Bulk construction leaves the map
+    /// stale because updating it per tet costs random writes; call this afterwards.
+    pub fn rebuild_vertex_map(&mut self) {
+        self.vert_tet.iter_mut().for_each(|x| *x = u32::MAX);
+        for (i, t) in self.tets.iter().enumerate() {
+            if t.v[0] != DEAD {
+                for &x in &t.v {
+                    if x != GHOST {
+                        self.vert_tet[x as usize] = i as TetId;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sets the tet recorded for vertex `v`.
+    #[inline]
+    pub fn set_vertex_tet(&mut self, v: VertexId, t: TetId) {
+        self.vert_tet[v as usize] = t;
+    }
+
+    /// Frees tet `t`. Its neighbours' links to it must be rewired by the caller.
+    #[inline]
+    pub fn kill_tet(&mut self, t: TetId) {
+        self.tets[t as usize].v[0] = DEAD;
+        self.free.push(t);
+    }
+
+    /// Glues face `a` to face `b` (both directions).
+    #[inline(always)]
+    pub fn glue(&mut self, a: FaceRef, b: FaceRef) {
+        self.tets[a.tet() as usize].adj[a.face()] = b;
+        self.tets[b.tet() as usize].adj[b.face()] = a;
+    }
+
+    /// Points face `a` at face `b` without touching `b`'s link (a one-way link, used
+    /// while an old tet is about to be discarded).
+    #[inline(always)]
+    pub fn set_link(&mut self, a: FaceRef, b: FaceRef) {
+        self.tets[a.tet() as usize].adj[a.face()] = b;
+    }
+
+    /// The vertices of face `i` of tet `t`, ordered so that `v[i]` is on its positive side.
+    #[inline(always)]
+    pub fn face_verts(&self, t: TetId, i: usize) -> [VertexId; 3] {
+        let v = &self.tets[t as usize].v;
+        let f = FACE_VERTS[i];
+        [v[f[0]], v[f[1]], v[f[2]]]
+    }
+
+    /// Iterates over the ids of live tets, ghosts included.
+    pub fn live_tets(&self) -> impl Iterator<Item = TetId> + '_ {
+        self.tets
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.v[0] != DEAD)
+            .map(|(i, _)| i as TetId)
+    }
+
+    /// Iterates over the ids of live non-ghost tets.
+    pub fn real_tets(&self) -> impl Iterator<Item = TetId> + '_ {
+        self.tets
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.v[0] != DEAD && t.v[3] != GHOST)
+            .map(|(i, _)| i as TetId)
+    }
+
+    /// Checks that every link is symmetric and glues faces with the same vertex set in
+    /// opposite orientations. Returns a description of the first problem found.
+    pub fn check_links(&self) -> Result<(), String> {
+        for t in self.live_tets() {
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                let g = self.adj(f);
+                if !self.is_alive(g.tet()) {
+                    return Err(format!("tet {t} face {i} links to a dead tet {}", g.tet()));
+                }
+                if self.adj(g) != f {
+                    return Err(format!("tet {t} face {i}: link is not symmetric"));
+                }
+                let a = self.face_verts(t, i);
+                let b = self.face_verts(g.tet(), g.face());
+                // Opposite orientation: b is a cyclic rotation of a reversed.
+                let r = [a[0], a[2], a[1]];
+                let same = (0..3).any(|k| b == [r[k], r[(k + 1) % 3], r[(k + 2) % 3]]);
+                if !same {
+                    return Err(format!(
+                        "tet {t} face {i} {a:?} is glued to tet {} face {} {b:?}",
+                        g.tet(),
+                        g.face()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_verts_are_even_permutations() {
+        for (i, f) in FACE_VERTS.iter().enumerate() {
+            let p = [f[0], f[1], f[2], i];
+            let mut inversions = 0;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    if p[a] > p[b] {
+                        inversions += 1;
+                    }
+                }
+            }
+            assert_eq!(inversions % 2, 0, "face {i}");
+        }
+    }
+
+    #[test]
+    fn face_refs_address_more_than_2_pow_31_slots() {
+        let t = (MAX_TETS - 1) as TetId;
+        let f = FaceRef::new(t, 3);
+        assert_eq!(f.tet(), t);
+        assert_eq!(f.face(), 3);
+        assert!(f.0 as usize > (1usize << 31));
+    }
+
+    #[test]
+    fn slots_are_reused_and_links_checked() {
+        let mut m = Mesh::new(5);
+        let a = m.add_tet([0, 1, 2, 3]).unwrap();
+        let b = m.add_tet([1, 0, 2, 4]).unwrap();
+        // Face 3 of a is (0,1,2); face 3 of b is (1,0,2): the same face, reversed.
+        m.glue(FaceRef::new(a, 3), FaceRef::new(b, 3));
+        m.kill_tet(b);
+        let c = m.add_tet([1, 0, 2, 4]).unwrap();
+        assert_eq!(b, c);
+        m.rebuild_vertex_map();
+        assert_eq!(m.vertex_tet(4), Some(c));
+        assert!(m.check_links().is_err()); // the other faces are unset
+    }
+}

@@ -1,0 +1,31 @@
+//! The finished mesh in flat, arena-free form: what the writers and the checker consume.
+
+/// A finished tetrahedral mesh, numbered from 0, with tets in TetGen's orientation.
+#[derive(Clone, Debug, Default)]
+pub struct MeshOut {
+    /// Node coordinates: the input points in input order, then Steiner points.
+    pub points: Vec<[f64; 3]>,
+    /// Number of attributes per node.
+    pub num_point_attrs: usize,
+    /// Node attributes, `num_point_attrs` per node (Steiner points get zeros).
+    pub point_attrs: Vec<f64>,
+    /// Node boundary markers, when the input had them.
+    pub point_markers: Option<Vec<i32>>,
+    /// Tets as 0-based node indices. TetGen's orientation: the Shewchuk orient3d of
+    /// (a, b, c, d) is negative, i.e. d lies above the counterclockwise triangle a, b, c.
+    pub tets: Vec<[u32; 4]>,
+    /// For tet `i`, `neighbors[i][j]` is the tet opposite node `j`, or -1 on the boundary.
+    pub neighbors: Vec<[i64; 4]>,
+    /// Number of attributes per tet (1 with `-A`, else 0).
+    pub num_tet_attrs: usize,
+    /// Tet attributes, `num_tet_attrs` per tet.
+    pub tet_attrs: Vec<f64>,
+    /// Constrained faces (subpolygons) with their facet markers; empty for point sets.
+    pub subfaces: Vec<([u32; 3], i32)>,
+    /// Constrained edges (subsegments) with their markers; empty for point sets.
+    pub subsegments: Vec<([u32; 2], i32)>,
+    /// True when the mesh came from a PLC (`-p`), which changes what `.face` and `.edge` hold.
+    pub plc_mode: bool,
+    /// Number of the first node in the input (0 or 1); output follows it unless `-z`.
+    pub first_index: usize,
+}
