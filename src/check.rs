@@ -234,22 +234,26 @@ fn check_boundary(mesh: &MeshOut, boundary: &[(u32, u8)], pr: &mut Problems) {
         k = j;
     }
     // The enclosed volume (divergence theorem) must equal the tets' total volume. Faces
-    // are oriented inward, so each contributes the signed volume of its cone to the origin.
-    let mut enclosed = 0.0;
-    let mut scale = 0.0;
-    let o = [0.0; 3];
-    for &(t, f) in boundary {
-        let fv = oriented_face(&mesh.tets[t as usize], f as usize);
-        let v = orient3d(p(fv[0]), p(fv[1]), p(fv[2]), &o);
+    // are oriented inward, so each contributes the signed volume of its cone to a centre.
+    // Both sums are rounded, so they are compared within their summed error bounds.
+    let centre = {
+        let v0 = p(boundary_face(mesh, boundary[0])[0]);
+        *v0
+    };
+    let (mut enclosed, mut err) = (0.0, 0.0);
+    for &bf in boundary {
+        let fv = boundary_face(mesh, bf);
+        let (v, e) = volume6_with_error(p(fv[0]), p(fv[1]), p(fv[2]), &centre);
         enclosed += v;
-        scale += v.abs();
+        err += e;
     }
-    let total: f64 = mesh
-        .tets
-        .iter()
-        .map(|t| orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])))
-        .sum();
-    let tol = 1e-9 * (scale + total.abs()) + f64::MIN_POSITIVE;
+    let mut total = 0.0;
+    for t in &mesh.tets {
+        let (v, e) = volume6_with_error(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
+        total += v;
+        err += e;
+    }
+    let tol = err + 1e-12 * (enclosed.abs() + total.abs()) + f64::MIN_POSITIVE;
     if (enclosed - total).abs() > tol {
         pr.push(format!(
             "the boundary encloses volume {} but the tets' volumes sum to {}",
@@ -257,6 +261,26 @@ fn check_boundary(mesh: &MeshOut, boundary: &[(u32, u8)], pr: &mut Problems) {
             total / 6.0
         ));
     }
+}
+
+/// The inward-oriented vertices of a boundary face.
+fn boundary_face(mesh: &MeshOut, (t, f): (u32, u8)) -> [u32; 3] {
+    oriented_face(&mesh.tets[t as usize], f as usize)
+}
+
+/// Six times the signed volume of `abcd` in our orientation, in floating point, with a
+/// bound on its rounding error (Shewchuk's first-stage bound on the permanent).
+fn volume6_with_error(a: &Point, b: &Point, c: &Point, d: &Point) -> (f64, f64) {
+    let u = [a[0] - d[0], a[1] - d[1], a[2] - d[2]];
+    let v = [b[0] - d[0], b[1] - d[1], b[2] - d[2]];
+    let w = [c[0] - d[0], c[1] - d[1], c[2] - d[2]];
+    let det = u[2] * (v[0] * w[1] - w[0] * v[1])
+        + v[2] * (w[0] * u[1] - u[0] * w[1])
+        + w[2] * (u[0] * v[1] - v[0] * u[1]);
+    let perm = u[2].abs() * ((v[0] * w[1]).abs() + (w[0] * v[1]).abs())
+        + v[2].abs() * ((w[0] * u[1]).abs() + (u[0] * w[1]).abs())
+        + w[2].abs() * ((u[0] * v[1]).abs() + (v[0] * u[1]).abs());
+    (-det, 1e-15 * perm)
 }
 
 /// At a hull edge the two hull faces must meet convexly; when they are coplanar, the
