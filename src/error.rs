@@ -66,6 +66,12 @@ pub enum MeshError {
     /// All input points are coplanar, collinear or coincident: no tetrahedron exists.
     #[error("{0}")]
     Degenerate(String),
+    /// The PLC is invalid in a way found while meshing (e.g. a vertex on a segment).
+    #[error("invalid PLC: {0}")]
+    InvalidPlc(String),
+    /// Meshing could not finish (e.g. the Steiner point limit was reached).
+    #[error("{0}")]
+    Failed(String),
     /// The input asks for something the mesher cannot do.
     #[error("{0}")]
     Unsupported(String),
@@ -111,7 +117,7 @@ impl Error {
         match self {
             Error::Input(InputError::Io { .. }) | Error::Output { .. } => EXIT_IO,
             Error::Input(_) => EXIT_INVALID_INPUT,
-            Error::Mesh(MeshError::Degenerate(_)) => EXIT_INVALID_INPUT,
+            Error::Mesh(MeshError::Degenerate(_) | MeshError::InvalidPlc(_)) => EXIT_INVALID_INPUT,
             Error::Mesh(_) => EXIT_MESH_FAILED,
         }
     }

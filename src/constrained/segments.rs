@@ -1,0 +1,277 @@
+//! Segment recovery: every segment missing from the Delaunay tetrahedralization is split
+//! with Steiner points until each of its subsegments is a mesh edge.
+//!
+//! Split points avoid needlessly short edges where segments meet at acute angles: next to
+//! an acute vertex a subsegment is split on a sphere centred at that vertex whose radius
+//! is a power of two (concentric shells, as Si & Gärtner and Shewchuk do), so the
+//! subsegments around the vertex shrink together and protect it; elsewhere the midpoint
+//! is used. Steiner points are computed from the segment's original endpoints, so they
+//! lie on the segment up to rounding.
+
+use crate::delaunay::Delaunay;
+use crate::error::MeshError;
+use crate::geom::Point;
+use crate::mesh::VertexId;
+
+/// The recovered segments.
+#[derive(Clone, Debug, Default)]
+pub struct Subsegments {
+    /// For each input segment, its vertices (internal ids) from one end to the other.
+    pub chains: Vec<Vec<VertexId>>,
+    /// Number of Steiner points inserted.
+    pub steiner_points: usize,
+}
+
+/// One piece of a segment, between parameters `s0 < s1` along it.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    seg: usize,
+    s0: f64,
+    u: VertexId,
+    s1: f64,
+    v: VertexId,
+}
+
+/// Splits the missing segments of `dt` until all are chains of mesh edges.
+///
+/// `segments` are pairs of input indices; `next_pert` is the perturbation (and output)
+/// index of the next Steiner point and is advanced; at most `max_steiner` points are added.
+pub fn recover_segments(
+    dt: &mut Delaunay,
+    segments: &[[u32; 2]],
+    n_input: usize,
+    next_pert: &mut u32,
+    max_steiner: usize,
+) -> Result<Subsegments, MeshError> {
+    let inv = dt.internal_ids(n_input);
+    let mut ends = Vec::with_capacity(segments.len());
+    for &[a, b] in segments {
+        let (ia, ib) = (inv[a as usize], inv[b as usize]);
+        if ia == u32::MAX || ib == u32::MAX {
+            return Err(MeshError::Internal(format!(
+                "segment ({a}, {b}) has no vertex"
+            )));
+        }
+        ends.push([ia, ib]);
+    }
+    let acute = acute_vertices(dt, &ends);
+    let mut splits: Vec<Vec<(f64, VertexId)>> = vec![Vec::new(); segments.len()];
+    let mut queue: Vec<Piece> = ends
+        .iter()
+        .enumerate()
+        .map(|(seg, &[u, v])| Piece {
+            seg,
+            s0: 0.0,
+            u,
+            s1: 1.0,
+            v,
+        })
+        .collect();
+    let mut done: Vec<Piece> = Vec::with_capacity(segments.len());
+    let mut scratch = Vec::new();
+    let mut steiner = 0usize;
+    loop {
+        while let Some(pc) = queue.pop() {
+            if dt.has_edge(pc.u, pc.v, &mut scratch) {
+                done.push(pc);
+                continue;
+            }
+            if steiner >= max_steiner {
+                return Err(MeshError::Failed(format!(
+                    "segment recovery needs more than {max_steiner} Steiner points \
+                     (raise the limit with -S)"
+                )));
+            }
+            let [a, b] = ends[pc.seg];
+            let s = split_parameter(dt, pc, [a, b], &acute);
+            let pa = dt.points[a as usize];
+            let pb = dt.points[b as usize];
+            let x: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
+            if x == dt.points[pc.u as usize] || x == dt.points[pc.v as usize] {
+                return Err(MeshError::Failed(format!(
+                    "segment ({}, {}) cannot be split finely enough in floating point",
+                    dt.orig[a as usize], dt.orig[b as usize]
+                )));
+            }
+            let Some(w) = dt.insert_steiner(x, *next_pert)? else {
+                return Err(MeshError::InvalidPlc(format!(
+                    "segment ({}, {}) passes through another vertex or segment near {:?}",
+                    dt.orig[a as usize], dt.orig[b as usize], x
+                )));
+            };
+            *next_pert += 1;
+            steiner += 1;
+            splits[pc.seg].push((s, w));
+            queue.push(Piece {
+                seg: pc.seg,
+                s0: pc.s0,
+                u: pc.u,
+                s1: s,
+                v: w,
+            });
+            queue.push(Piece {
+                seg: pc.seg,
+                s0: s,
+                u: w,
+                s1: pc.s1,
+                v: pc.v,
+            });
+        }
+        // Later insertions can destroy subsegments recovered earlier; recheck them all.
+        let before = done.len();
+        let mut kept = Vec::with_capacity(before);
+        for pc in done.drain(..) {
+            if dt.has_edge(pc.u, pc.v, &mut scratch) {
+                kept.push(pc);
+            } else {
+                queue.push(pc);
+            }
+        }
+        done = kept;
+        if queue.is_empty() {
+            break;
+        }
+    }
+    let chains = ends
+        .iter()
+        .zip(splits.iter_mut())
+        .map(|(&[a, b], sp)| {
+            sp.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let mut chain = Vec::with_capacity(sp.len() + 2);
+            chain.push(a);
+            chain.extend(sp.iter().map(|&(_, w)| w));
+            chain.push(b);
+            chain
+        })
+        .collect();
+    Ok(Subsegments {
+        chains,
+        steiner_points: steiner,
+    })
+}
+
+/// Vertices where two segments meet at less than 90 degrees.
+fn acute_vertices(dt: &Delaunay, ends: &[[VertexId; 2]]) -> Vec<bool> {
+    let mut incident: Vec<(VertexId, VertexId)> = Vec::with_capacity(ends.len() * 2);
+    for &[a, b] in ends {
+        incident.push((a, b));
+        incident.push((b, a));
+    }
+    incident.sort_unstable();
+    let mut acute = vec![false; dt.points.len()];
+    let p = |v: VertexId| dt.points[v as usize];
+    let mut i = 0;
+    while i < incident.len() {
+        let mut j = i + 1;
+        while j < incident.len() && incident[j].0 == incident[i].0 {
+            j += 1;
+        }
+        let c = p(incident[i].0);
+        let dir = |v: VertexId| {
+            let q = p(v);
+            [q[0] - c[0], q[1] - c[1], q[2] - c[2]]
+        };
+        'pairs: for x in i..j {
+            for y in x + 1..j {
+                let (d1, d2) = (dir(incident[x].1), dir(incident[y].1));
+                if d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2] > 0.0 {
+                    acute[incident[i].0 as usize] = true;
+                    break 'pairs;
+                }
+            }
+        }
+        i = j;
+    }
+    acute
+}
+
+/// Where to split a piece: on a power-of-two sphere around an acute segment endpoint,
+/// else at the middle.
+fn split_parameter(dt: &Delaunay, pc: Piece, [a, b]: [VertexId; 2], acute: &[bool]) -> f64 {
+    let mid = 0.5 * (pc.s0 + pc.s1);
+    let from_a = pc.u == a && acute[a as usize];
+    let from_b = pc.v == b && acute[b as usize];
+    if from_a == from_b {
+        return mid;
+    }
+    let pa = dt.points[a as usize];
+    let pb = dt.points[b as usize];
+    let len = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt();
+    let piece = len * (pc.s1 - pc.s0);
+    if !(piece > 0.0 && piece.is_finite()) {
+        return mid;
+    }
+    // The power of two nearest to half the piece lies within [piece/3, 2 piece/3].
+    let r = 2f64.powi((piece * 0.5).log2().round() as i32);
+    let t = r / len;
+    let s = if from_a { pc.s0 + t } else { pc.s1 - t };
+    if s > pc.s0 && s < pc.s1 {
+        s
+    } else {
+        mid
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(s: &mut u64) -> f64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*s >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn long_segments_through_a_cloud_are_recovered() {
+        let mut s = 3u64;
+        let mut pts: Vec<Point> = (0..400)
+            .map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)])
+            .collect();
+        // Two long segments meeting at an acute angle at point 400.
+        pts.push([-0.1, -0.1, -0.1]);
+        pts.push([1.1, 1.1, 1.05]);
+        pts.push([1.1, 1.0, 1.1]);
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let mut next = pts.len() as u32;
+        let segs = [[400, 401], [400, 402]];
+        let rec = recover_segments(&mut dt, &segs, pts.len(), &mut next, 10_000).unwrap();
+        assert!(rec.steiner_points > 0);
+        dt.mesh.check_links().unwrap();
+        let mut scratch = Vec::new();
+        for chain in &rec.chains {
+            for w in chain.windows(2) {
+                assert!(dt.has_edge(w[0], w[1], &mut scratch));
+            }
+        }
+        // Around the acute vertex, the first subsegments have power-of-two lengths.
+        let apex = dt.points[rec.chains[0][0] as usize];
+        for chain in &rec.chains {
+            let q = dt.points[chain[1] as usize];
+            let d =
+                ((q[0] - apex[0]).powi(2) + (q[1] - apex[1]).powi(2) + (q[2] - apex[2]).powi(2))
+                    .sqrt();
+            let l = d.log2();
+            assert!(
+                (l - l.round()).abs() < 1e-9,
+                "length {d} is not a power of two"
+            );
+        }
+    }
+
+    #[test]
+    fn a_vertex_on_a_segment_is_an_invalid_plc() {
+        let mut pts: Vec<Point> = vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+        pts.extend([
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+        ]);
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let mut next = pts.len() as u32;
+        let e = recover_segments(&mut dt, &[[0, 1]], pts.len(), &mut next, 100).unwrap_err();
+        assert!(e.to_string().contains("passes through"), "{e}");
+    }
+}
