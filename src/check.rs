@@ -94,6 +94,15 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
         }
     }
     faces.sort_unstable();
+    let subfaces: rustc_hash::FxHashSet<[u32; 3]> = mesh
+        .subfaces
+        .iter()
+        .map(|(f, _)| {
+            let mut k = *f;
+            k.sort_unstable();
+            k
+        })
+        .collect();
     let mut boundary: Vec<(u32, u8)> = Vec::new();
     let mut k = 0;
     while k < faces.len() {
@@ -103,7 +112,10 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
         }
         match j - k {
             1 => boundary.push((faces[k].tet, faces[k].face)),
-            2 => check_interior_face(mesh, faces[k], faces[k + 1], &mut pr),
+            2 => {
+                let constrained = subfaces.contains(&faces[k].key);
+                check_interior_face(mesh, faces[k], faces[k + 1], constrained, &mut pr)
+            }
             m => pr.push(format!(
                 "face {:?} is shared by {m} tets",
                 faces[k].key.map(|v| v as usize + base)
@@ -112,9 +124,217 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
         k = j;
     }
     drop(faces);
+    check_hull_faces(mesh, &mut boundary, &mut pr);
     check_boundary(mesh, &boundary, &mut pr);
-    check_vertices_used(plc, mesh, &mut pr);
+    if mesh.plc_mode {
+        check_constraints(plc, mesh, &subfaces, &boundary, &mut pr);
+    } else {
+        check_vertices_used(plc, mesh, &mut pr);
+    }
     pr.finish()
+}
+
+/// If the mesh lists its hull faces, they must be the boundary faces, reversed (normals
+/// pointing out), in the order of their tets and faces. Sorts `boundary` that way.
+fn check_hull_faces(mesh: &MeshOut, boundary: &mut [(u32, u8)], pr: &mut Problems) {
+    boundary.sort_unstable();
+    if mesh.hull_faces.is_empty() || mesh.plc_mode {
+        return;
+    }
+    let base = mesh.first_index;
+    if mesh.hull_faces.len() != boundary.len() {
+        pr.push(format!(
+            "the mesh lists {} hull faces but has {} boundary faces",
+            mesh.hull_faces.len(),
+            boundary.len()
+        ));
+        return;
+    }
+    for (k, (&(t, f), h)) in boundary.iter().zip(&mesh.hull_faces).enumerate() {
+        let o = oriented_face(&mesh.tets[t as usize], f as usize);
+        if *h != [o[0], o[2], o[1]] {
+            pr.push(format!(
+                "hull face {} {:?} should be {:?} (face {f} of tet {})",
+                k + base,
+                shift(h, base),
+                shift(&[o[0], o[2], o[1]], base),
+                t as usize + base
+            ));
+        }
+    }
+}
+
+/// PLC meshes: every subsegment and subface is in the mesh, every input segment is a
+/// chain of subsegments, every polygon vertex is a mesh vertex, and the boundary of the
+/// mesh lies on polygons (unless the convex hull was kept).
+fn check_constraints(
+    plc: &Plc,
+    mesh: &MeshOut,
+    subfaces: &rustc_hash::FxHashSet<[u32; 3]>,
+    boundary: &[(u32, u8)],
+    pr: &mut Problems,
+) {
+    use rustc_hash::{FxHashMap, FxHashSet};
+    let base = mesh.first_index;
+    let mut edges: FxHashSet<(u32, u32)> = FxHashSet::default();
+    let mut faces: FxHashSet<[u32; 3]> = FxHashSet::default();
+    for t in &mesh.tets {
+        for a in 0..4 {
+            for b in a + 1..4 {
+                edges.insert((t[a].min(t[b]), t[a].max(t[b])));
+            }
+        }
+        for fv in FACE_VERTS {
+            let mut k = [t[fv[0]], t[fv[1]], t[fv[2]]];
+            k.sort_unstable();
+            faces.insert(k);
+        }
+    }
+    for &([a, b], _) in &mesh.subsegments {
+        if !edges.contains(&(a.min(b), a.max(b))) {
+            pr.push(format!(
+                "subsegment ({}, {}) is not a mesh edge",
+                a as usize + base,
+                b as usize + base
+            ));
+        }
+    }
+    for f in subfaces {
+        if !faces.contains(f) {
+            pr.push(format!("subface {:?} is not a mesh face", shift(f, base)));
+        }
+    }
+    if !mesh.convex_hull_kept {
+        for &(t, f) in boundary {
+            let mut k = oriented_face(&mesh.tets[t as usize], f as usize);
+            k.sort_unstable();
+            if !subfaces.contains(&k) {
+                pr.push(format!(
+                    "boundary face {:?} lies on no polygon",
+                    shift(&k, base)
+                ));
+            }
+        }
+    }
+    // Each polygon edge must be joined up by subsegments running along it.
+    let mut adj: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for &([a, b], _) in &mesh.subsegments {
+        adj.entry(a).or_default().push(b);
+        adj.entry(b).or_default().push(a);
+    }
+    let rep = representatives(plc);
+    let mut seen_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
+    for (fi, facet) in plc.facets.iter().enumerate() {
+        for poly in &facet.polygons {
+            let ring: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
+            let n = ring.len();
+            if n < 2 {
+                continue;
+            }
+            let count = if n == 2 { 1 } else { n };
+            for k in 0..count {
+                let (a, b) = (ring[k], ring[(k + 1) % n]);
+                if a == b || !seen_edges.insert((a.min(b), a.max(b))) {
+                    continue;
+                }
+                if !joined_along(mesh, &adj, a, b) {
+                    // Edges between merged coplanar polygons are not constraints: they
+                    // need no subsegments, but their facets still cover them.
+                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, &rep, a, b) {
+                        pr.push(format!(
+                            "facet {}: edge ({}, {}) is not covered by subsegments",
+                            fi + base,
+                            a as usize + base,
+                            b as usize + base
+                        ));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The lowest-indexed point with the same coordinates, for each point.
+fn representatives(plc: &Plc) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..plc.points.len() as u32).collect();
+    let key = |i: u32| plc.points[i as usize].map(|c| (c + 0.0).to_bits());
+    order.sort_unstable_by_key(|&i| (key(i), i));
+    let mut rep: Vec<u32> = (0..plc.points.len() as u32).collect();
+    for w in 1..order.len() {
+        if key(order[w]) == key(order[w - 1]) {
+            rep[order[w] as usize] = rep[order[w - 1] as usize];
+        }
+    }
+    rep
+}
+
+/// Is edge `ab` used by a single polygon, or by polygons that are not coplanar? (Then it
+/// is a segment; TetGen drops only edges between coplanar neighbours.)
+fn is_segment(plc: &Plc, rep: &[u32], a: u32, b: u32) -> bool {
+    let mut users = 0;
+    for f in &plc.facets {
+        for poly in &f.polygons {
+            let ring: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
+            let n = ring.len();
+            if n == 2 && ((ring[0] == a && ring[1] == b) || (ring[0] == b && ring[1] == a)) {
+                return true;
+            }
+            if n >= 3
+                && (0..n).any(|k| {
+                    let (x, y) = (ring[k], ring[(k + 1) % n]);
+                    (x == a && y == b) || (x == b && y == a)
+                })
+            {
+                users += 1;
+            }
+        }
+    }
+    users != 2
+}
+
+/// Is there a path of subsegments from `a` to `b` whose vertices stay within rounding
+/// distance of the line through them?
+fn joined_along(
+    mesh: &MeshOut,
+    adj: &rustc_hash::FxHashMap<u32, Vec<u32>>,
+    a: u32,
+    b: u32,
+) -> bool {
+    let pa = mesh.points[a as usize];
+    let pb = mesh.points[b as usize];
+    let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+    let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if len2 == 0.0 {
+        return false;
+    }
+    // Steiner points are rounded to the nearest doubles: allow a few ulps of the
+    // coordinates' magnitude.
+    let scale = pa
+        .iter()
+        .chain(pb.iter())
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    let tol2 = 3.0 * (1e-14 * scale).powi(2) + 1e-300;
+    let on_line = |v: u32| {
+        let p = mesh.points[v as usize];
+        let w: [f64; 3] = std::array::from_fn(|k| p[k] - pa[k]);
+        let t = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / len2;
+        let off: f64 = (0..3).map(|k| (w[k] - t * d[k]).powi(2)).sum();
+        (-1e-9..=1.0 + 1e-9).contains(&t) && off <= tol2
+    };
+    let mut stack = vec![a];
+    let mut seen = rustc_hash::FxHashSet::default();
+    seen.insert(a);
+    while let Some(v) = stack.pop() {
+        if v == b {
+            return true;
+        }
+        for &w in adj.get(&v).map(|x| x.as_slice()).unwrap_or(&[]) {
+            if seen.insert(w) && on_line(w) {
+                stack.push(w);
+            }
+        }
+    }
+    false
 }
 
 fn shift(t: &[u32], base: usize) -> Vec<usize> {
@@ -127,7 +347,13 @@ fn oriented_face(t: &[u32; 4], f: usize) -> [u32; 3] {
     [t[fv[0]], t[fv[1]], t[fv[2]]]
 }
 
-fn check_interior_face(mesh: &MeshOut, a: FaceEntry, b: FaceEntry, pr: &mut Problems) {
+fn check_interior_face(
+    mesh: &MeshOut,
+    a: FaceEntry,
+    b: FaceEntry,
+    constrained: bool,
+    pr: &mut Problems,
+) {
     let base = mesh.first_index;
     let ta = &mesh.tets[a.tet as usize];
     let tb = &mesh.tets[b.tet as usize];
@@ -161,7 +387,8 @@ fn check_interior_face(mesh: &MeshOut, a: FaceEntry, b: FaceEntry, pr: &mut Prob
             ));
         }
     }
-    if !mesh.plc_mode {
+    // Only faces on polygons may fail to be locally Delaunay (the CDT property).
+    if !constrained {
         let q = [ta[0], ta[1], ta[2], ta[3], e];
         let s = insphere_sos(q.map(|v| &pts[v as usize]), q);
         if s != Sign::Negative {
@@ -220,7 +447,15 @@ fn check_boundary(mesh: &MeshOut, boundary: &[(u32, u8)], pr: &mut Problems) {
             j += 1;
         }
         let (a, b) = (undirected[k].0, undirected[k].1);
-        if j - k != 2 || undirected[k].3 == undirected[k + 1].3 {
+        let forward = undirected[k..j].iter().filter(|e| e.3).count();
+        // A PLC's boundary may be non-manifold at an edge (two solids touching along
+        // it), but must still pair every face with one of opposite direction.
+        let paired = if mesh.plc_mode {
+            (j - k) % 2 == 0 && 2 * forward == j - k
+        } else {
+            j - k == 2 && forward == 1
+        };
+        if !paired {
             pr.push(format!(
                 "boundary edge ({}, {}) is in {} boundary faces, not two of opposite sides",
                 a as usize + base,
@@ -379,6 +614,19 @@ mod tests {
     fn a_delaunay_mesh_passes() {
         let plc = cube_with_center();
         check_mesh(&plc, &meshed(&plc)).unwrap();
+    }
+
+    #[test]
+    fn wrong_hull_faces_fail() {
+        let plc = cube_with_center();
+        let mut m = meshed(&plc);
+        assert!(!m.hull_faces.is_empty());
+        m.hull_faces[0].swap(1, 2);
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(e.contains("hull face 0"), "{e}");
+        m.hull_faces.pop();
+        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        assert!(e.contains("hull faces but has"), "{e}");
     }
 
     #[test]

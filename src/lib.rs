@@ -7,7 +7,9 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod carve;
 pub mod check;
+pub mod constrained;
 pub mod delaunay;
 pub mod error;
 pub mod geom;

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 
 /// Whether PLC meshing (`-p`) is implemented. While false, `-p` is refused as a usage
 /// error; flipping it turns `-p` (and with it `-C`/`-F`) on.
-pub const PLC_IMPLEMENTED: bool = false;
+pub const PLC_IMPLEMENTED: bool = true;
 
 /// The algorithm that recovers the facets of a PLC.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -55,6 +55,14 @@ pub struct Options {
     pub output: Option<PathBuf>,
     /// `--check`: validate the mesh after writing it.
     pub check: bool,
+    /// `-M`: do not merge edge-adjacent coplanar facets; needs `-p`.
+    pub no_merge: bool,
+    /// `-c`: keep the convex hull instead of carving the exterior; needs `-p`.
+    pub keep_hull: bool,
+    /// `-A`: give each tet its region attribute; needs `-p`.
+    pub region_attributes: bool,
+    /// `-S`: the most Steiner points to add (`-S` alone or `-S0` means no limit).
+    pub max_steiner: Option<usize>,
 }
 
 /// One thing wrong with the switches.
@@ -162,17 +170,13 @@ enum Arg {
 const REFUSED: &[(char, Arg, &str)] = &[
     ('q', Arg::Numbers, "quality mesh generation"),
     ('a', Arg::Numbers, "maximum volume constraint"),
-    ('A', Arg::None, "region attributes"),
     ('r', Arg::None, "reconstruct a previous mesh"),
     ('Y', Arg::Numbers, "preserve the input surface mesh"),
     ('i', Arg::None, "insert additional points"),
     ('m', Arg::None, "mesh sizing function"),
-    ('M', Arg::Numbers, "no merging of coplanar facets"),
     ('T', Arg::Numbers, "coplanarity tolerance"),
-    ('S', Arg::Numbers, "maximum number of Steiner points"),
     ('R', Arg::Numbers, "mesh coarsening"),
     ('d', Arg::None, "detection of self-intersections"),
-    ('c', Arg::None, "convex hull retention"),
     ('D', Arg::Numbers, "conforming Delaunay refinement"),
     (
         'L',
@@ -205,6 +209,9 @@ const REFUSED: &[(char, Arg, &str)] = &[
 const NEED_PLC: &[(char, &str)] = &[
     ('C', "cavity facet insertion"),
     ('F', "flip facet insertion"),
+    ('M', "no merging of coplanar facets"),
+    ('c', "convex hull retention"),
+    ('A', "region attributes"),
 ];
 
 /// What the parser noticed across all switch strings, for the checks made at the end.
@@ -212,6 +219,9 @@ const NEED_PLC: &[(char, &str)] = &[
 struct Seen {
     cavity: bool,
     flip: bool,
+    no_merge: bool,
+    keep_hull: bool,
+    regions: bool,
     problems: Vec<SwitchProblem>,
 }
 
@@ -296,6 +306,21 @@ impl Options {
                     seen.flip = true;
                     true
                 }
+                'M' => {
+                    self.no_merge = true;
+                    seen.no_merge = true;
+                    true
+                }
+                'c' => {
+                    self.keep_hull = true;
+                    seen.keep_hull = true;
+                    true
+                }
+                'A' => {
+                    self.region_attributes = true;
+                    seen.regions = true;
+                    true
+                }
                 _ => false,
             };
             if simple {
@@ -309,6 +334,21 @@ impl Options {
                 continue;
             }
             match c {
+                'S' => {
+                    let num = take_numbers(&chars, &mut i);
+                    if num.is_empty() {
+                        self.max_steiner = None;
+                    } else {
+                        match num.parse::<usize>() {
+                            Ok(0) => self.max_steiner = None,
+                            Ok(n) => self.max_steiner = Some(n),
+                            Err(_) => seen.problems.push(SwitchProblem::BadArgument {
+                                switch: 'S',
+                                text: num,
+                            }),
+                        }
+                    }
+                }
                 'O' => {
                     // -O0 (no optimization) is what we always do; any other level is refused.
                     let num = take_numbers(&chars, &mut i);
@@ -373,12 +413,25 @@ impl Options {
                 },
             );
         }
+        if seen.flip {
+            seen.problems.push(SwitchProblem::Unimplemented {
+                switch: "F".into(),
+                what: "facet insertion by flips",
+            });
+        }
         if seen.cavity && seen.flip {
             seen.problems.push(SwitchProblem::Conflict('C', 'F'));
         }
         if !self.plc {
             for &(c, what) in NEED_PLC {
-                if (c == 'C' && seen.cavity) || (c == 'F' && seen.flip) {
+                let given = match c {
+                    'C' => seen.cavity,
+                    'F' => seen.flip,
+                    'M' => seen.no_merge,
+                    'c' => seen.keep_hull,
+                    _ => seen.regions,
+                };
+                if given {
                     seen.problems.push(SwitchProblem::Needs {
                         switch: c,
                         needs: "-p",
@@ -559,9 +612,10 @@ mod tests {
     fn refused_switches_name_themselves() {
         // (switches, substrings the message must contain)
         let table: &[(&[&str], &[&str])] = &[
-            (&["-p"], &["-p (PLC meshing) is not implemented yet"]),
-            (&["-pV"], &["-p (PLC meshing)"]),
-            (&["-pC"], &["-p (PLC meshing)"]),
+            (
+                &["-pF"],
+                &["-F (facet insertion by flips) is not implemented yet"],
+            ),
             (
                 &["-q"],
                 &["-q (quality mesh generation) is not implemented"],
@@ -573,12 +627,12 @@ mod tests {
             (&["-a1e-3"], &["-a1e-3 (maximum volume"]),
             (&["-r"], &["-r (reconstruct"]),
             (&["-Y"], &["-Y (preserve"]),
-            (&["-A"], &["-A (region attributes"]),
-            (&["-c"], &["-c (convex hull"]),
-            (&["-M"], &["-M (no merging"]),
+            (&["-A"], &["-A (region attributes) needs -p"]),
+            (&["-c"], &["-c (convex hull retention) needs -p"]),
+            (&["-M"], &["-M (no merging of coplanar facets) needs -p"]),
             (&["-d"], &["-d (detection"]),
             (&["-T1e-8"], &["-T1e-8 (coplanarity"]),
-            (&["-S100"], &["-S100 (maximum number of Steiner"]),
+            (&["-S1y"], &["unknown switch -y"]),
             (&["-R"], &["-R (mesh coarsening"]),
             (&["-m"], &["-m (mesh sizing"]),
             (&["-i"], &["-i (insert"]),
@@ -635,10 +689,10 @@ mod tests {
     fn numbers_do_not_swallow_following_switches() {
         // Every problem of the string is reported, so the later letters must parse.
         let table: &[(&str, &[&str])] = &[
-            ("-pq1.2a0.5", &["-p (", "-q1.2 (", "-a0.5 ("]),
+            ("-pq1.2a0.5", &["-q1.2 (", "-a0.5 ("]),
             ("-q1.2/15zy", &["-q1.2/15 (", "unknown switch -y"]),
             ("-q1.2e", &["-q1.2 ("]),
-            ("-a.5T1e+3S10k", &["-a.5 (", "-T1e+3 (", "-S10 (", "-k ("]),
+            ("-a.5T1e+3S10k", &["-a.5 (", "-T1e+3 (", "-k ("]),
             ("-O2/7Vq", &["-O2/7 (", "-q ("]),
         ];
         for (s, wants) in table {
@@ -674,19 +728,23 @@ mod tests {
             e.problems[..],
             [SwitchProblem::Needs { switch: 'C', .. }]
         ));
-        let e = Options::from_switches(["-p"]).unwrap_err();
+        let e = Options::from_switches(["-pF"]).unwrap_err();
         assert_eq!(
             e.problems,
             vec![SwitchProblem::Unimplemented {
-                switch: "p".into(),
-                what: "PLC meshing"
+                switch: "F".into(),
+                what: "facet insertion by flips"
             }]
         );
+        let o = Options::from_switches(["-pcAMS500"]).unwrap();
+        assert!(o.plc && o.keep_hull && o.region_attributes && o.no_merge);
+        assert_eq!(o.max_steiner, Some(500));
+        assert_eq!(Options::from_switches(["-pS"]).unwrap().max_steiner, None);
     }
 
     #[test]
     fn facet_algo_selection() {
-        // -C/-F set the field even though, without a working -p, the run is refused.
+        // -C/-F set the field (and -F is then refused as not implemented yet).
         let mut o = Options::default();
         let _ = o.apply_switches(["-pF"]);
         assert!(o.plc);

@@ -15,7 +15,14 @@ pub struct MeshOut {
     /// (a, b, c, d) is negative, i.e. d lies above the counterclockwise triangle a, b, c.
     pub tets: Vec<[u32; 4]>,
     /// For tet `i`, `neighbors[i][j]` is the tet opposite node `j`, or -1 on the boundary.
+    /// May be empty (a point set meshed without `-n`, `-f` or `-e` skips it): consumers
+    /// that need it derive it from `tets` (see `io::write::Derived`).
     pub neighbors: Vec<[i64; 4]>,
+    /// Point sets: the convex hull faces, oriented with their normals pointing out of the
+    /// mesh (counterclockwise seen from outside), in the order of their tets and, within
+    /// a tet, of the node opposite them: the `.face` file's order. When empty, the
+    /// writer derives the hull from the neighbours instead.
+    pub hull_faces: Vec<[u32; 3]>,
     /// Number of attributes per tet (1 with `-A`, else 0).
     pub num_tet_attrs: usize,
     /// Tet attributes, `num_tet_attrs` per tet.
@@ -28,4 +35,6 @@ pub struct MeshOut {
     pub plc_mode: bool,
     /// Number of the first node in the input (0 or 1); output follows it unless `-z`.
     pub first_index: usize,
+    /// True when the exterior was kept (`-c`), so the boundary need not lie on polygons.
+    pub convex_hull_kept: bool,
 }

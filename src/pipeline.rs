@@ -12,9 +12,7 @@ use std::time::Instant;
 /// Runs the pipeline on `plc` as `opts` asks.
 pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
     if opts.plc {
-        return Err(
-            MeshError::Unsupported("PLC meshing (-p) is not implemented yet".into()).into(),
-        );
+        return run_plc(plc, opts);
     }
     let start = Instant::now();
     let mut stats = Stats {
@@ -33,16 +31,20 @@ pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
         ));
     }
     stats.duplicate_points = built.duplicates.len();
-    let (tets, neighbors) = built.dt.export();
-    stats.output_tets = tets.len();
-    stats.hull_faces = neighbors.iter().flatten().filter(|&&n| n < 0).count();
+    // The neighbour table costs 32 bytes a tet and a pass over the arena; only the
+    // .neigh, all-faces and edge writers need it.
+    let need_neighbors = opts.write_neighbors || opts.all_faces || opts.write_edges;
+    let out = built.dt.export_with(need_neighbors);
+    stats.output_tets = out.tets.len();
+    stats.hull_faces = out.hull_faces.len();
     let mesh = MeshOut {
         points: plc.points.clone(),
         num_point_attrs: plc.num_point_attrs,
         point_attrs: plc.point_attrs.clone(),
         point_markers: plc.point_markers.clone(),
-        tets,
-        neighbors,
+        tets: out.tets,
+        neighbors: out.neighbors,
+        hull_faces: out.hull_faces,
         first_index: plc.first_index,
         ..Default::default()
     };
@@ -51,5 +53,37 @@ pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
         mesh,
         stats,
         warnings,
+    })
+}
+
+/// The `-p` pipeline: the constrained Delaunay tetrahedralization of the PLC, carved.
+fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
+    if opts.facet_algo == crate::options::FacetAlgo::Flip {
+        return Err(MeshError::Unsupported(
+            "facet insertion by flips (-F) is not implemented yet".into(),
+        )
+        .into());
+    }
+    let start = Instant::now();
+    let popts = crate::constrained::PlcOptions {
+        merge: !opts.no_merge,
+        keep_hull: opts.keep_hull,
+        region_attributes: opts.region_attributes,
+        max_steiner: opts.max_steiner.unwrap_or(usize::MAX),
+    };
+    let done = crate::constrained::mesh_plc(plc, &popts)?;
+    let ps = done.stats;
+    let stats = Stats {
+        input_points: plc.points.len(),
+        output_tets: ps.output_tets,
+        delaunay_secs: ps.delaunay_secs,
+        total_secs: start.elapsed().as_secs_f64(),
+        plc: Some(ps),
+        ..Default::default()
+    };
+    Ok(Meshed {
+        mesh: done.mesh,
+        stats,
+        warnings: done.warnings,
     })
 }

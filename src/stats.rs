@@ -17,4 +17,6 @@ pub struct Stats {
     pub delaunay_secs: f64,
     /// Seconds of the whole meshing call.
     pub total_secs: f64,
+    /// The figures of PLC meshing (`-p`), the rows of the paper's Table 1.
+    pub plc: Option<crate::constrained::PlcStats>,
 }

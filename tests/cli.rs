@@ -60,12 +60,12 @@ fn usage_errors_exit_2_naming_the_switch() {
     write_points(&dir.path().join("p.node"), 8, 1);
     let table: &[(&[&str], &str)] = &[
         (
-            &["-p", "p.node"],
-            "switch -p (PLC meshing) is not implemented yet",
+            &["-pF", "p.node"],
+            "switch -F (facet insertion by flips) is not implemented yet",
         ),
         (
-            &["-pV", "p.node"],
-            "switch -p (PLC meshing) is not implemented yet",
+            &["-c", "p.node"],
+            "switch -c (convex hull retention) needs -p",
         ),
         (
             &["-q1.2", "p.node"],
@@ -127,7 +127,7 @@ fn every_problem_of_a_switch_string_is_reported() {
     write_points(&dir.path().join("p.node"), 8, 1);
     let (code, _, stderr) = run_in(dir.path(), &["-pq1.2/15a0.5yV", "p.node"]);
     assert_eq!(code, 2);
-    for want in ["-p (", "-q1.2/15 (", "-a0.5 (", "unknown switch -y"] {
+    for want in ["-q1.2/15 (", "-a0.5 (", "unknown switch -y"] {
         assert!(stderr.contains(want), "{stderr:?} lacks {want:?}");
     }
 }

@@ -1,6 +1,707 @@
 //! Constrained Delaunay tetrahedralization of a PLC: preparation of the PLC, segment
-//! recovery with Steiner points, and facet insertion.
+//! recovery with Steiner points, and facet insertion, then carving.
+//!
+//! [`mesh_plc`] runs read PLC → Delaunay → segments → facets → carve. When a polygon
+//! that is not flat needs a Steiner point on it (paper §3.1), the point is added to the
+//! facet and the whole construction starts again from the Delaunay tetrahedralization:
+//! simple to get right, and rare in practice.
 
+pub mod cavity;
+pub mod cdt;
 pub mod facet2d;
 pub mod prepare;
 pub mod segments;
+
+use crate::carve::carve;
+use crate::delaunay::Delaunay;
+use crate::error::{Error, MeshError};
+use crate::geom::Point;
+use crate::mesh::VertexId;
+use crate::output::MeshOut;
+use crate::plc::Plc;
+use cavity::{insert_region, Outcome};
+use cdt::{edge_key, face_key, Cdt};
+use prepare::{prepare, PreparedPlc};
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::time::Instant;
+
+/// What `-p` meshing needs to know beyond the PLC.
+#[derive(Clone, Debug)]
+pub struct PlcOptions {
+    /// Merge edge-adjacent coplanar facets (TetGen's default; `-M` turns it off).
+    pub merge: bool,
+    /// Keep the convex hull instead of carving the exterior (`-c`).
+    pub keep_hull: bool,
+    /// Give each tet its region attribute (`-A`).
+    pub region_attributes: bool,
+    /// The most Steiner points to add (`-S`).
+    pub max_steiner: usize,
+}
+
+impl Default for PlcOptions {
+    fn default() -> Self {
+        PlcOptions {
+            merge: true,
+            keep_hull: false,
+            region_attributes: false,
+            max_steiner: 10_000_000,
+        }
+    }
+}
+
+/// Figures of a PLC meshing run: the rows of the paper's Table 1.
+#[derive(Clone, Debug, Default)]
+pub struct PlcStats {
+    /// Input vertices.
+    pub input_points: usize,
+    /// Input polygons.
+    pub input_polygons: usize,
+    /// Steiner points added, in total.
+    pub steiner_points: usize,
+    /// Of those, the ones on polygons (for polygons that are not flat).
+    pub facet_steiner_points: usize,
+    /// Output tets.
+    pub output_tets: usize,
+    /// Output subpolygons (triangles on input polygons).
+    pub output_subfaces: usize,
+    /// Subpolygons that had to be recovered (missing from the Delaunay tetrahedralization).
+    pub recovered_subfaces: usize,
+    /// The most subpolygons recovered in one missing region.
+    pub max_region_subfaces: usize,
+    /// Missing regions inserted.
+    pub regions: usize,
+    /// Crossing tets deleted, in total.
+    pub crossing_tets: usize,
+    /// The most crossing tets of one missing region.
+    pub max_region_crossing_tets: usize,
+    /// Tets added to cavities by enlargement.
+    pub enlarged_tets: usize,
+    /// Restarts caused by Steiner points on polygons.
+    pub restarts: usize,
+    /// Seconds for the Delaunay tetrahedralization.
+    pub delaunay_secs: f64,
+    /// Seconds for segment recovery.
+    pub segment_secs: f64,
+    /// Seconds for facet recovery.
+    pub facet_secs: f64,
+    /// Seconds for carving.
+    pub carve_secs: f64,
+}
+
+/// The finished PLC mesh, its figures, and warnings for the user.
+pub struct PlcMesh {
+    /// The mesh in output form.
+    pub mesh: MeshOut,
+    /// Figures.
+    pub stats: PlcStats,
+    /// Warnings.
+    pub warnings: Vec<String>,
+}
+
+/// The most restarts for Steiner points on polygons before giving up.
+const MAX_RESTARTS: usize = 64;
+
+/// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
+pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
+    let prep = prepare(plc, opts.merge)?;
+    let mut warnings = Vec::new();
+    for &(dup, kept) in &prep.duplicates {
+        warnings.push(format!(
+            "point {} coincides with point {} and is merged with it",
+            dup as usize + plc.first_index,
+            kept as usize + plc.first_index
+        ));
+    }
+    let mut stats = PlcStats {
+        input_points: plc.points.len(),
+        input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
+        ..Default::default()
+    };
+    // Steiner points on polygons, found by earlier attempts: (merged facet, point); and
+    // split points on segments: (segment, parameter).
+    let mut facet_points: Vec<(usize, Point)> = Vec::new();
+    let mut presplits: Vec<(usize, f64)> = Vec::new();
+    loop {
+        match attempt(plc, &prep, &facet_points, &presplits, opts, &mut stats)? {
+            Attempt::Done(mut cdt, seg_markers) => {
+                let more = resolve_shims(&mut cdt, plc, opts);
+                if more.is_empty() {
+                    stats.facet_steiner_points = facet_points.len();
+                    let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats)?;
+                    return Ok(PlcMesh {
+                        mesh,
+                        stats,
+                        warnings,
+                    });
+                }
+                stats.restarts += 1;
+                if stats.restarts > MAX_RESTARTS {
+                    return Err(MeshError::Failed(
+                        "shim tets survive on polygons that are not flat".into(),
+                    )
+                    .into());
+                }
+                facet_points.extend(more);
+            }
+            Attempt::Restart(more, splits) => {
+                stats.restarts += 1;
+                if stats.restarts > MAX_RESTARTS
+                    || facet_points.len() + more.len() > opts.max_steiner
+                {
+                    return Err(MeshError::Failed(format!(
+                        "polygons that are not flat still conflict after {} Steiner points on them",
+                        facet_points.len()
+                    ))
+                    .into());
+                }
+                facet_points.extend(more);
+                presplits.extend(splits);
+            }
+        }
+    }
+}
+
+enum Attempt {
+    Done(Box<Cdt>, FxHashMap<(VertexId, VertexId), i32>),
+    Restart(Vec<(usize, Point)>, Vec<(usize, f64)>),
+}
+
+/// One construction from scratch: Delaunay, segments, facets.
+fn attempt(
+    plc: &Plc,
+    prep: &PreparedPlc,
+    facet_points: &[(usize, Point)],
+    presplits: &[(usize, f64)],
+    opts: &PlcOptions,
+    stats: &mut PlcStats,
+) -> Result<Attempt, Error> {
+    let n_input = plc.points.len();
+    let mut points = plc.points.clone();
+    points.extend(facet_points.iter().map(|&(_, p)| p));
+    // Duplicated input points go to their representative; only those are meshed.
+    let t0 = Instant::now();
+    let mut dt = Delaunay::build(&points)?.dt;
+    stats.delaunay_secs = t0.elapsed().as_secs_f64();
+
+    let t1 = Instant::now();
+    let mut next_pert = points.len() as u32;
+    let budget = opts.max_steiner.saturating_sub(facet_points.len());
+    let subsegs = segments::recover_segments(
+        &mut dt,
+        &prep.segments,
+        points.len(),
+        &mut next_pert,
+        budget,
+        presplits,
+    )?;
+    stats.segment_secs = t1.elapsed().as_secs_f64();
+    stats.steiner_points = facet_points.len() + subsegs.steiner_points;
+
+    let t2 = Instant::now();
+    let inv = dt.internal_ids(points.len());
+    let mut cdt = Cdt::new(dt);
+    let seg_index: FxHashMap<(u32, u32), usize> = prep
+        .segments
+        .iter()
+        .enumerate()
+        .map(|(i, s)| ((s[0], s[1]), i))
+        .collect();
+    // Each subsegment takes the marker of the first facet that contains its segment.
+    let mut seg_marker = vec![None; prep.segments.len()];
+    for f in &prep.facets {
+        for_each_edge(f, |a, b| {
+            if let Some(&i) = seg_index.get(&(a.min(b), a.max(b))) {
+                seg_marker[i].get_or_insert(f.marker);
+            }
+        });
+    }
+    let mut seg_markers = FxHashMap::default();
+    let mut seg_of: FxHashMap<(VertexId, VertexId), usize> = FxHashMap::default();
+    for (i, chain) in subsegs.chains.iter().enumerate() {
+        for w in chain.windows(2) {
+            seg_markers.insert(edge_key(w[0], w[1]), seg_marker[i].unwrap_or(0));
+            seg_of.insert(edge_key(w[0], w[1]), i);
+        }
+    }
+    let mut splits: Vec<(usize, f64)> = Vec::new();
+    cdt.subsegs = seg_markers.clone();
+
+    let mut extra: Vec<Vec<VertexId>> = vec![Vec::new(); prep.facets.len()];
+    for (k, &(f, _)) in facet_points.iter().enumerate() {
+        let v = inv[n_input + k];
+        if v != u32::MAX {
+            extra[f].push(v);
+        }
+    }
+    let mut queue: Vec<usize> = (0..prep.facets.len()).collect();
+    queue.reverse();
+    let mut queued: FxHashSet<usize> = queue.iter().copied().collect();
+    let mut steiner: Vec<(usize, Point)> = Vec::new();
+    let mut steiner_facets: FxHashSet<usize> = FxHashSet::default();
+    let mut rounds = 0usize;
+    let max_rounds = 20 * prep.facets.len() + 1000;
+    while let Some(fi) = queue.pop() {
+        queued.remove(&fi);
+        rounds += 1;
+        if rounds > max_rounds {
+            return Err(MeshError::Failed("facet recovery does not converge".into()).into());
+        }
+        if steiner_facets.contains(&fi) {
+            continue;
+        }
+        let f = &prep.facets[fi];
+        let mut verts: Vec<VertexId> = Vec::new();
+        let mut constraints: Vec<[VertexId; 2]> = Vec::new();
+        let add_edge =
+            |a: u32, b: u32, verts: &mut Vec<VertexId>, cons: &mut Vec<[VertexId; 2]>| {
+                match seg_index.get(&(a.min(b), a.max(b))) {
+                    Some(&si) => {
+                        let chain = &subsegs.chains[si];
+                        verts.extend_from_slice(chain);
+                        cons.extend(chain.windows(2).map(|w| [w[0], w[1]]));
+                    }
+                    None => {
+                        verts.push(inv[a as usize]);
+                        verts.push(inv[b as usize]);
+                    }
+                }
+            };
+        for ring in &f.rings {
+            for k in 0..ring.len() {
+                add_edge(
+                    ring[k],
+                    ring[(k + 1) % ring.len()],
+                    &mut verts,
+                    &mut constraints,
+                );
+            }
+        }
+        for s in &f.inner_segments {
+            add_edge(s[0], s[1], &mut verts, &mut constraints);
+        }
+        for &v in &f.isolated {
+            verts.push(inv[v as usize]);
+        }
+        verts.extend_from_slice(&extra[fi]);
+        if verts.contains(&u32::MAX) {
+            return Err(MeshError::Internal(format!(
+                "facet {fi} has a vertex missing from the mesh"
+            ))
+            .into());
+        }
+        verts.sort_unstable();
+        verts.dedup();
+        if f.rings.is_empty() {
+            continue;
+        }
+        let mut tris = facet2d::triangulate_facet(
+            &cdt.dt.points,
+            &cdt.dt.orig,
+            &verts,
+            &constraints,
+            &f.holes,
+            f.normal,
+        )
+        .map_err(|e| MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f))))?;
+        // A merged facet covers only its polygons: keep the triangles reachable from the
+        // inner side of its polygons' edges without crossing a subsegment (gaps that the
+        // polygons enclose without covering are not reachable from the hull's flood).
+        if f.source_facets.len() > 1 {
+            tris = inside_polygons(
+                &cdt.dt.points,
+                &tris,
+                f,
+                &inv,
+                &seg_index,
+                &subsegs,
+                &constraints,
+            );
+        }
+        let mut missing = Vec::new();
+        for t in &tris {
+            if cdt.find_face(t[0], t[1], t[2]).is_some() {
+                cdt.subfaces.insert(face_key(*t), fi as u32);
+            } else {
+                missing.push(*t);
+            }
+        }
+        for region in regions_of(&missing, &seg_markers) {
+            match insert_region(&mut cdt, &region, fi as u32, f.normal)? {
+                Outcome::Inserted(rs) => {
+                    stats.regions += 1;
+                    stats.recovered_subfaces += rs.subfaces;
+                    stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);
+                    stats.crossing_tets += rs.crossing_tets;
+                    stats.max_region_crossing_tets =
+                        stats.max_region_crossing_tets.max(rs.crossing_tets);
+                    stats.enlarged_tets += rs.enlarged_tets;
+                    for lf in rs.lost {
+                        if queued.insert(lf as usize) {
+                            queue.push(lf as usize);
+                        }
+                    }
+                }
+                Outcome::NeedsSteiner(p) => {
+                    steiner.push((fi, p));
+                    steiner_facets.insert(fi);
+                    break;
+                }
+                Outcome::SplitSubsegment(u, v) => {
+                    let seg = seg_of[&edge_key(u, v)];
+                    let [a, b] = [
+                        subsegs.chains[seg][0],
+                        *subsegs.chains[seg].last().unwrap_or(&u),
+                    ];
+                    let param = |x: VertexId| {
+                        let (pa, pb, px) = (
+                            cdt.dt.points[a as usize],
+                            cdt.dt.points[b as usize],
+                            cdt.dt.points[x as usize],
+                        );
+                        let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+                        let num: f64 = (0..3).map(|k| (px[k] - pa[k]) * d[k]).sum();
+                        let den: f64 = (0..3).map(|k| d[k] * d[k]).sum();
+                        num / den
+                    };
+                    splits.push((seg, 0.5 * (param(u) + param(v))));
+                    steiner_facets.insert(fi);
+                    break;
+                }
+            }
+        }
+    }
+    stats.facet_secs = t2.elapsed().as_secs_f64();
+    if !steiner.is_empty() || !splits.is_empty() {
+        return Ok(Attempt::Restart(steiner, splits));
+    }
+    Ok(Attempt::Done(Box::new(cdt), seg_markers))
+}
+
+/// The triangles of `tris` on the inner side of `f`'s rings, flooding across edges that
+/// are not constraints.
+fn inside_polygons(
+    points: &[Point],
+    tris: &[[VertexId; 3]],
+    f: &prepare::MergedFacet,
+    inv: &[VertexId],
+    seg_index: &FxHashMap<(u32, u32), usize>,
+    subsegs: &segments::Subsegments,
+    constraints: &[[VertexId; 2]],
+) -> Vec<[VertexId; 3]> {
+    let n = f.normal;
+    let axis = (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(2);
+    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+    let o2 = |a: VertexId, b: VertexId, c: VertexId| {
+        let p = |v: VertexId| robust::Coord {
+            x: points[v as usize][u],
+            y: points[v as usize][w],
+        };
+        robust::orient2d(p(a), p(b), p(c))
+    };
+    let walls: FxHashSet<(VertexId, VertexId)> =
+        constraints.iter().map(|c| edge_key(c[0], c[1])).collect();
+    let mut by_edge: FxHashMap<(VertexId, VertexId), Vec<usize>> = FxHashMap::default();
+    for (i, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(edge_key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(i);
+        }
+    }
+    let mut keep = vec![false; tris.len()];
+    let mut stack = Vec::new();
+    for ring in &f.rings {
+        // The ring's orientation in the projection (shoelace): its inner side.
+        let area: f64 = (0..ring.len())
+            .map(|k| {
+                let (a, b) = (
+                    points[inv[ring[k] as usize] as usize],
+                    points[inv[ring[(k + 1) % ring.len()] as usize] as usize],
+                );
+                a[u] * b[w] - b[u] * a[w]
+            })
+            .sum();
+        if area == 0.0 {
+            continue;
+        }
+        for k in 0..ring.len() {
+            let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+            let mut chain: Vec<VertexId> = match seg_index.get(&(a.min(b), a.max(b))) {
+                Some(&si) => subsegs.chains[si].clone(),
+                None => vec![inv[a as usize], inv[b as usize]],
+            };
+            if chain.first() != Some(&inv[a as usize]) {
+                chain.reverse();
+            }
+            for e in chain.windows(2) {
+                for &ti in by_edge
+                    .get(&edge_key(e[0], e[1]))
+                    .map(|x| x.as_slice())
+                    .unwrap_or(&[])
+                {
+                    let x = tris[ti]
+                        .iter()
+                        .copied()
+                        .find(|&x| x != e[0] && x != e[1])
+                        .unwrap_or(e[0]);
+                    if o2(e[0], e[1], x) * area > 0.0 && !keep[ti] {
+                        keep[ti] = true;
+                        stack.push(ti);
+                    }
+                }
+            }
+        }
+    }
+    while let Some(ti) = stack.pop() {
+        let t = tris[ti];
+        for k in 0..3 {
+            let e = edge_key(t[k], t[(k + 1) % 3]);
+            if walls.contains(&e) {
+                continue;
+            }
+            for &tj in &by_edge[&e] {
+                if !keep[tj] {
+                    keep[tj] = true;
+                    stack.push(tj);
+                }
+            }
+        }
+    }
+    tris.iter()
+        .zip(keep)
+        .filter(|(_, k)| *k)
+        .map(|(t, _)| *t)
+        .collect()
+}
+
+/// Removes shim tets (four vertices on one facet) from the domain. A shim that carving
+/// would keep has its two subfaces on the outer side; taking its other two faces as the
+/// polygon's triangles instead puts it outside, where carving removes it. A shim that
+/// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
+/// are returned, and the construction starts again.
+fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Point)> {
+    let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
+    for (k, &f) in &cdt.subfaces {
+        facet_verts.entry(f).or_default().extend(k.iter().copied());
+    }
+    let mut steiner = Vec::new();
+    for _round in 0..8 {
+        let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
+        let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
+        let mut swapped = false;
+        let mut needs: Vec<(usize, Point)> = Vec::new();
+        for &t in &carved.tets {
+            let v = cdt.dt.mesh.verts(t);
+            let faces: Vec<[VertexId; 3]> = crate::mesh::FACE_VERTS
+                .iter()
+                .map(|fv| face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
+                .collect();
+            let Some(facet) = faces.iter().find_map(|k| cdt.subfaces.get(k).copied()) else {
+                continue;
+            };
+            if !v.iter().all(|x| facet_verts[&facet].contains(x)) {
+                continue;
+            }
+            let (sub, free): (Vec<[VertexId; 3]>, Vec<[VertexId; 3]>) =
+                faces.iter().partition(|k| cdt.subfaces.contains_key(*k));
+            // The shim can leave the domain only if nothing behind its subfaces is in it.
+            let kept_behind_sub = sub.iter().any(|k: &[VertexId; 3]| {
+                let i = (0..4).find(|&i| !k.contains(&v[i])).unwrap_or(0);
+                kept.contains(&cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet())
+            });
+            if free.is_empty() || kept_behind_sub {
+                // Both sides of the polygon keep the shim: only a Steiner point helps.
+                let f = sub[0].map(|x| cdt.dt.points[x as usize]);
+                let c: Point = std::array::from_fn(|k| (f[0][k] + f[1][k] + f[2][k]) / 3.0);
+                needs.push((facet as usize, c));
+                continue;
+            }
+            for k in &sub {
+                cdt.subfaces.remove(k);
+            }
+            for k in free {
+                cdt.subfaces.insert(k, facet);
+            }
+            swapped = true;
+        }
+        if !needs.is_empty() {
+            steiner = needs;
+            break;
+        }
+        if !swapped {
+            break;
+        }
+    }
+    steiner
+}
+
+/// Calls `f` on every edge of the facet's rings and inner segments.
+fn for_each_edge(f: &prepare::MergedFacet, mut g: impl FnMut(u32, u32)) {
+    for ring in &f.rings {
+        for k in 0..ring.len() {
+            g(ring[k], ring[(k + 1) % ring.len()]);
+        }
+    }
+    for s in &f.inner_segments {
+        g(s[0], s[1]);
+    }
+}
+
+/// A facet's name for messages: its first input facet, numbered as in the file.
+fn facet_name(plc: &Plc, f: &prepare::MergedFacet) -> String {
+    let first = f.source_facets.first().copied().unwrap_or(0);
+    let line = plc.facets.get(first).map(|x| x.line).unwrap_or(0);
+    if line > 0 {
+        format!("{} (line {line})", first + plc.first_index)
+    } else {
+        format!("{}", first + plc.first_index)
+    }
+}
+
+/// Groups missing triangles into regions connected through shared edges that are not
+/// subsegments.
+fn regions_of(
+    missing: &[[VertexId; 3]],
+    subsegs: &FxHashMap<(VertexId, VertexId), i32>,
+) -> Vec<Vec<[VertexId; 3]>> {
+    let mut by_edge: FxHashMap<(VertexId, VertexId), Vec<usize>> = FxHashMap::default();
+    for (i, t) in missing.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(edge_key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(i);
+        }
+    }
+    let mut comp = vec![usize::MAX; missing.len()];
+    let mut out = Vec::new();
+    for s in 0..missing.len() {
+        if comp[s] != usize::MAX {
+            continue;
+        }
+        comp[s] = out.len();
+        let mut region = Vec::new();
+        let mut stack = vec![s];
+        while let Some(i) = stack.pop() {
+            region.push(missing[i]);
+            let t = missing[i];
+            for k in 0..3 {
+                let e = edge_key(t[k], t[(k + 1) % 3]);
+                if subsegs.contains_key(&e) {
+                    continue;
+                }
+                for &j in &by_edge[&e] {
+                    if comp[j] == usize::MAX {
+                        comp[j] = out.len();
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        out.push(region);
+    }
+    out
+}
+
+/// Carves the mesh and puts it in output form.
+fn finish(
+    plc: &Plc,
+    _prep: &PreparedPlc,
+    mut cdt: Cdt,
+    seg_markers: &FxHashMap<(VertexId, VertexId), i32>,
+    opts: &PlcOptions,
+    stats: &mut PlcStats,
+) -> Result<MeshOut, Error> {
+    let t = Instant::now();
+    let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
+    stats.carve_secs = t.elapsed().as_secs_f64();
+    if carved.tets.is_empty() {
+        return Err(MeshError::InvalidPlc(
+            "no tetrahedra remain after removing the exterior: the surface does not enclose a volume \
+             (is it closed?)"
+                .into(),
+        )
+        .into());
+    }
+    let n_out = cdt
+        .dt
+        .orig
+        .iter()
+        .map(|&o| o as usize + 1)
+        .max()
+        .unwrap_or(0)
+        .max(plc.points.len());
+    let mut points = plc.points.clone();
+    points.resize(n_out, [0.0; 3]);
+    for (v, &o) in cdt.dt.orig.iter().enumerate() {
+        points[o as usize] = cdt.dt.points[v];
+    }
+    let orig_ids = cdt.dt.orig.clone();
+    let orig = |v: VertexId| orig_ids[v as usize];
+    let mut kept = vec![false; cdt.dt.mesh.num_slots()];
+    for &t in &carved.tets {
+        kept[t as usize] = true;
+    }
+    let tets: Vec<[u32; 4]> = carved
+        .tets
+        .iter()
+        .map(|&t| cdt.dt.mesh.verts(t).map(orig))
+        .collect();
+    let mut subfaces = Vec::new();
+    let mut keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
+    keys.sort_unstable();
+    for (k, f) in keys {
+        let Some(fr) = cdt.find_face(k[0], k[1], k[2]) else {
+            continue;
+        };
+        let other = cdt.dt.mesh.adj(fr);
+        let (t, i) = if kept[fr.tet() as usize] {
+            (fr.tet(), fr.face())
+        } else if kept[other.tet() as usize] {
+            (other.tet(), other.face())
+        } else {
+            continue;
+        };
+        // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
+        let v = cdt.dt.mesh.face_verts(t, i).map(orig);
+        subfaces.push((v, _prep.facets[f as usize].marker));
+    }
+    let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
+        .iter()
+        .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
+        .collect();
+    subsegments.sort_unstable();
+    stats.output_tets = tets.len();
+    stats.output_subfaces = subfaces.len();
+    let n_attr = plc.num_point_attrs;
+    let mut point_attrs = plc.point_attrs.clone();
+    point_attrs.resize(n_out * n_attr, 0.0);
+    let point_markers = plc.point_markers.clone().map(|mut m| {
+        m.resize(n_out, 0);
+        m
+    });
+    let (num_tet_attrs, tet_attrs) = if opts.region_attributes {
+        (1, carved.attributes)
+    } else {
+        (0, Vec::new())
+    };
+    Ok(MeshOut {
+        points,
+        num_point_attrs: n_attr,
+        point_attrs,
+        point_markers,
+        tets,
+        neighbors: Vec::new(),
+        num_tet_attrs,
+        tet_attrs,
+        subfaces,
+        subsegments,
+        plc_mode: true,
+        first_index: plc.first_index,
+        convex_hull_kept: opts.keep_hull,
+        ..Default::default()
+    })
+}

@@ -42,6 +42,7 @@ pub fn recover_segments(
     n_input: usize,
     next_pert: &mut u32,
     max_steiner: usize,
+    presplits: &[(usize, f64)],
 ) -> Result<Subsegments, MeshError> {
     let inv = dt.internal_ids(n_input);
     let mut ends = Vec::with_capacity(segments.len());
@@ -56,20 +57,36 @@ pub fn recover_segments(
     }
     let acute = acute_vertices(dt, &ends);
     let mut splits: Vec<Vec<(f64, VertexId)>> = vec![Vec::new(); segments.len()];
-    let mut queue: Vec<Piece> = ends
-        .iter()
-        .enumerate()
-        .map(|(seg, &[u, v])| Piece {
-            seg,
-            s0: 0.0,
-            u,
-            s1: 1.0,
-            v,
-        })
-        .collect();
+    let mut steiner = 0usize;
+    // Split points asked for by an earlier attempt (to protect a subsegment that a cavity
+    // retriangulation would lose) go in first.
+    for &(seg, s) in presplits {
+        let [a, b] = ends[seg];
+        let (pa, pb) = (dt.points[a as usize], dt.points[b as usize]);
+        let x: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
+        if let Some(w) = dt.insert_steiner(x, *next_pert)? {
+            *next_pert += 1;
+            steiner += 1;
+            splits[seg].push((s, w));
+        }
+    }
+    let mut queue: Vec<Piece> = Vec::new();
+    for (seg, &[u, v]) in ends.iter().enumerate() {
+        splits[seg].sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut prev = (0.0, u);
+        for &(s, w) in splits[seg].iter().chain(std::iter::once(&(1.0, v))) {
+            queue.push(Piece {
+                seg,
+                s0: prev.0,
+                u: prev.1,
+                s1: s,
+                v: w,
+            });
+            prev = (s, w);
+        }
+    }
     let mut done: Vec<Piece> = Vec::with_capacity(segments.len());
     let mut scratch = Vec::new();
-    let mut steiner = 0usize;
     loop {
         while let Some(pc) = queue.pop() {
             if dt.has_edge(pc.u, pc.v, &mut scratch) {
@@ -236,7 +253,7 @@ mod tests {
         let mut dt = Delaunay::build(&pts).unwrap().dt;
         let mut next = pts.len() as u32;
         let segs = [[400, 401], [400, 402]];
-        let rec = recover_segments(&mut dt, &segs, pts.len(), &mut next, 10_000).unwrap();
+        let rec = recover_segments(&mut dt, &segs, pts.len(), &mut next, 10_000, &[]).unwrap();
         assert!(rec.steiner_points > 0);
         dt.mesh.check_links().unwrap();
         let mut scratch = Vec::new();
@@ -271,7 +288,7 @@ mod tests {
         ]);
         let mut dt = Delaunay::build(&pts).unwrap().dt;
         let mut next = pts.len() as u32;
-        let e = recover_segments(&mut dt, &[[0, 1]], pts.len(), &mut next, 100).unwrap_err();
+        let e = recover_segments(&mut dt, &[[0, 1]], pts.len(), &mut next, 100, &[]).unwrap_err();
         assert!(e.to_string().contains("passes through"), "{e}");
     }
 }

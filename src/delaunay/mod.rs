@@ -4,8 +4,8 @@
 
 use crate::error::MeshError;
 use crate::geom::hilbert::insertion_order;
-use crate::geom::{insphere, insphere_sos, orient3d, Point, Sign};
-use crate::mesh::{FaceRef, Mesh, TetId, VertexId, GHOST};
+use crate::geom::{insphere_sos, orient3d, Point, Sign, StaticFilter};
+use crate::mesh::{FaceRef, Mesh, TetId, VertexId, FACE_VERTS, GHOST};
 
 /// Where a point lies relative to the current triangulation.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -38,8 +38,23 @@ pub struct Delaunay {
     last: TetId,
     rng: u64,
     conflict: Vec<TetId>,
-    boundary: Vec<(TetId, usize)>,
+    /// The cavity's boundary faces, as the new tets that will rest on them.
+    boundary: Vec<NewTet>,
+    /// The tets made by the last insertion, each with its face opposite the new vertex.
     created: Vec<(TetId, usize)>,
+    edges: EdgeTable,
+    /// A box holding every vertex, and the predicates' static error bounds for it.
+    bbox: [Point; 2],
+    filter: StaticFilter,
+}
+
+/// A tet to be made by an insertion: its vertices (the new vertex in slot `face`) and
+/// the outside face it is glued to across face `face`.
+#[derive(Copy, Clone, Debug)]
+struct NewTet {
+    v: [VertexId; 4],
+    face: usize,
+    outside: FaceRef,
 }
 
 /// The outcome of building a Delaunay tetrahedralization of a point set.
@@ -81,7 +96,11 @@ impl Delaunay {
             conflict: Vec::new(),
             boundary: Vec::new(),
             created: Vec::new(),
+            edges: EdgeTable::default(),
+            bbox: [[0.0; 3]; 2],
+            filter: StaticFilter::new(&[0.0; 3], &[0.0; 3]),
         };
+        dt.set_bbox(bounding_box(&dt.points));
         // A DT of n random points has about 6.5 n tets; reserve to avoid regrowth.
         let expected = n * 7 + 16;
         dt.mesh.reserve(expected);
@@ -98,6 +117,12 @@ impl Delaunay {
             dt,
             duplicates: order.duplicates,
         })
+    }
+
+    /// Sets the box holding every vertex, and the static filter bounds that go with it.
+    fn set_bbox(&mut self, bbox: [Point; 2]) {
+        self.bbox = bbox;
+        self.filter = StaticFilter::new(&bbox[0], &bbox[1]);
     }
 
     /// Creates the first tet from four affinely independent points (the earliest in
@@ -191,7 +216,9 @@ impl Delaunay {
                     continue;
                 }
                 let f = self.mesh.face_verts(t, i);
-                let o = orient3d(self.pt(f[0]), self.pt(f[1]), self.pt(f[2]), p);
+                let o = self
+                    .filter
+                    .orient3d(self.pt(f[0]), self.pt(f[1]), self.pt(f[2]), p);
                 if o < 0.0 {
                     next = Some(self.mesh.adj(FaceRef::new(t, i)));
                     break;
@@ -224,7 +251,9 @@ impl Delaunay {
     fn in_conflict(&self, t: TetId, p: &Point, pv: VertexId) -> bool {
         let v = self.mesh.verts(t);
         if v[3] == GHOST {
-            let o = orient3d(self.pt(v[0]), self.pt(v[1]), self.pt(v[2]), p);
+            let o = self
+                .filter
+                .orient3d(self.pt(v[0]), self.pt(v[1]), self.pt(v[2]), p);
             if o != 0.0 {
                 return o > 0.0;
             }
@@ -247,7 +276,7 @@ impl Delaunay {
             self.pt(v[3]),
             p,
         ];
-        let s = insphere(pts[0], pts[1], pts[2], pts[3], pts[4]);
+        let s = self.filter.insphere(pts[0], pts[1], pts[2], pts[3], pts[4]);
         if s != 0.0 {
             return s > 0.0;
         }
@@ -259,6 +288,14 @@ impl Delaunay {
     /// an existing vertex and was skipped.
     pub fn insert(&mut self, pv: VertexId) -> Result<bool, MeshError> {
         let p = *self.pt(pv);
+        let [lo, hi] = self.bbox;
+        if (0..3).any(|k| !(lo[k] <= p[k] && p[k] <= hi[k])) {
+            // A Steiner point outside the box: the static bounds must cover it.
+            self.set_bbox([
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            ]);
+        }
         let start = match self.locate(&p) {
             Location::Vertex(_) => return Ok(false),
             Location::Inside(t) | Location::Outside(t) => t,
@@ -276,83 +313,84 @@ impl Delaunay {
         while k < self.conflict.len() {
             let t = self.conflict[k];
             k += 1;
-            for f in 0..4 {
-                let n = self.mesh.adj(FaceRef::new(t, f)).tet();
-                match self.mark[n as usize] {
-                    IN_CONFLICT => {}
-                    OUTSIDE => self.boundary.push((t, f)),
-                    _ => {
-                        if self.in_conflict(n, &p, pv) {
-                            self.mark[n as usize] = IN_CONFLICT;
-                            self.conflict.push(n);
-                        } else {
-                            self.mark[n as usize] = OUTSIDE;
-                            self.boundary.push((t, f));
-                        }
-                    }
-                }
-            }
-        }
-        self.fill_cavity(pv)
-    }
-
-    /// Replaces the conflict tets by the fan of new tets from `pv` to the cavity boundary.
-    ///
-    /// The new tets take fresh slots, so the conflict tets can still be read while the new
-    /// ones are glued: each boundary face's link is redirected to its new tet, and the
-    /// neighbour of a new tet across a face through `pv` is found by turning around the
-    /// cavity edge in that face, through the old tets, until a redirected link is met.
-    fn fill_cavity(&mut self, pv: VertexId) -> Result<bool, MeshError> {
-        self.created.clear();
-        let mut real = None;
-        for bi in 0..self.boundary.len() {
-            let (t, f) = self.boundary[bi];
-            let mut v = self.mesh.verts(t);
-            v[f] = pv;
-            let outside = self.mesh.adj(FaceRef::new(t, f));
-            let n = self.add_tet(v)?;
-            self.mesh.glue(FaceRef::new(n, f), outside);
-            self.mesh.set_link(FaceRef::new(t, f), FaceRef::new(n, f));
-            self.mark[n as usize] = NEW;
-            self.created.push((n, f));
-            if v[3] != GHOST {
-                real = Some(n);
-            }
-        }
-        for bi in 0..self.boundary.len() {
-            let (t, f) = self.boundary[bi];
-            let (n, _) = self.created[bi];
-            for k in 0..4 {
-                if k == f || self.mesh.tet(n).adj[k].0 != u32::MAX {
+            // One copy of the tet: its vertices and links are all read below.
+            let tet = *self.mesh.tet(t);
+            for (f, &outside) in tet.adj.iter().enumerate() {
+                let n = outside.tet();
+                let state = self.mark[n as usize];
+                if state == IN_CONFLICT {
                     continue;
                 }
-                let tv = self.mesh.verts(t);
-                let (a, b) = other_two(f, k);
-                let (ea, eb) = (tv[a], tv[b]);
-                let (mut cur, mut face) = (t, k);
-                loop {
-                    let next = self.mesh.adj(FaceRef::new(cur, face));
-                    let nt = next.tet();
-                    let cv = self.mesh.verts(cur);
-                    if self.mark[nt as usize] == NEW {
-                        let w = third_slot(&cv, face, ea, eb);
-                        self.mesh.glue(FaceRef::new(n, k), FaceRef::new(nt, w));
-                        break;
+                if state != OUTSIDE {
+                    if self.in_conflict(n, &p, pv) {
+                        self.mark[n as usize] = IN_CONFLICT;
+                        self.conflict.push(n);
+                        continue;
                     }
-                    face = third_slot(&self.mesh.verts(nt), next.face(), ea, eb);
-                    cur = nt;
+                    self.mark[n as usize] = OUTSIDE;
                 }
+                // A select rather than `v[f] = pv`: storing one lane at a variable
+                // index and reloading the whole array stalls store forwarding.
+                let v = std::array::from_fn(|i| if i == f { pv } else { tet.v[i] });
+                self.boundary.push(NewTet {
+                    v,
+                    face: f,
+                    outside,
+                });
             }
         }
-        for i in 0..self.conflict.len() {
+        self.fill_cavity()
+    }
+
+    /// Replaces the conflict tets by the fan of new tets from the new vertex to the cavity
+    /// boundary (`self.boundary`, which already holds everything read from the old tets).
+    ///
+    /// The new tets reuse the conflict tets' slots first: those are hot in cache. Two new
+    /// tets are neighbours across a face through the new vertex exactly when their
+    /// boundary faces share an edge, which the two faces see in opposite directions; so
+    /// every face first files its directed edge in a small hash table, then looks up the
+    /// reversed edge. (This replaced turning around each edge through the old tets, which
+    /// cost a quarter of the build; two passes keep the branches predictable.)
+    fn fill_cavity(&mut self) -> Result<bool, MeshError> {
+        self.created.clear();
+        let stamp = self.edges.start(self.boundary.len());
+        let mut real = None;
+        for i in 0..self.boundary.len() {
+            let nt = self.boundary[i];
+            let n = match self.conflict.get(i) {
+                Some(&t) => {
+                    self.mesh.reset_tet(t, nt.v);
+                    t
+                }
+                None => self.add_tet(nt.v)?,
+            };
+            self.mark[n as usize] = 0;
+            self.mesh.glue(FaceRef::new(n, nt.face), nt.outside);
+            self.mark[nt.outside.tet() as usize] = 0;
+            self.created.push((n, nt.face));
+            if nt.v[3] != GHOST {
+                real = Some(n);
+            }
+            for (k, (a, b)) in FAN_EDGES[nt.face] {
+                self.edges
+                    .insert(stamp, nt.v[a], nt.v[b], FaceRef::new(n, k));
+            }
+        }
+        for i in 0..self.boundary.len() {
+            let (n, f) = self.created[i];
+            let v = self.boundary[i].v;
+            for (k, (a, b)) in FAN_EDGES[f] {
+                // Every edge of a closed cavity boundary is filed from both sides.
+                let there = self.edges.find(stamp, v[b], v[a]).ok_or_else(|| {
+                    MeshError::Internal(format!("cavity edge ({}, {}) has no twin", v[b], v[a]))
+                })?;
+                self.mesh.set_link(FaceRef::new(n, k), there);
+            }
+        }
+        for i in self.boundary.len()..self.conflict.len() {
             let t = self.conflict[i];
             self.mark[t as usize] = 0;
             self.mesh.kill_tet(t);
-        }
-        for &(n, f) in &self.created {
-            self.mark[n as usize] = 0;
-            let outside = self.mesh.adj(FaceRef::new(n, f)).tet();
-            self.mark[outside as usize] = 0;
         }
         if let Some(t) = real {
             self.last = t;
@@ -385,33 +423,124 @@ impl Delaunay {
     }
 }
 
-/// The two slots of a tet other than `j` and `k`.
-#[inline(always)]
-fn other_two(j: usize, k: usize) -> (usize, usize) {
-    let mut r = [0usize; 2];
-    let mut n = 0;
-    for s in 0..4 {
-        if s != j && s != k {
-            r[n] = s;
-            n += 1;
+/// `FAN_EDGES[j]`: for a new tet whose new vertex sits in slot `j`, its three faces `k`
+/// through that vertex, each with the slots `(a, b)` such that the face, seen as in
+/// [`FACE_VERTS`], is the cyclic order `(j, a, b)`. The neighbour across face `k` sees
+/// the same face reversed, as `(new vertex, v[b], v[a])`.
+const FAN_EDGES: [[(usize, (usize, usize)); 3]; 4] = {
+    let mut t = [[(0, (0, 0)); 3]; 4];
+    let mut j = 0;
+    while j < 4 {
+        let mut n = 0;
+        let mut k = 0;
+        while k < 4 {
+            if k != j {
+                let f = FACE_VERTS[k];
+                let p = if f[0] == j {
+                    0
+                } else if f[1] == j {
+                    1
+                } else {
+                    2
+                };
+                t[j][n] = (k, (f[(p + 1) % 3], f[(p + 2) % 3]));
+                n += 1;
+            }
+            k += 1;
         }
+        j += 1;
     }
-    (r[0], r[1])
-}
+    t
+};
 
 /// Marks of tets during one insertion.
 const IN_CONFLICT: u8 = 1;
 const OUTSIDE: u8 = 2;
-const NEW: u8 = 3;
 
-/// The slot of `v` other than `skip` holding neither `a` nor `b`.
-#[inline(always)]
-fn third_slot(v: &[VertexId; 4], skip: usize, a: VertexId, b: VertexId) -> usize {
-    // Branch-free: the four slots sum to 6, and `a`, `b` are in `v` exactly once.
-    let slot = |x: VertexId| {
-        usize::from(v[1] == x) + 2 * usize::from(v[2] == x) + 3 * usize::from(v[3] == x)
-    };
-    6 - skip - slot(a) - slot(b)
+/// The directed edges of one insertion's cavity boundary, each with the new face that
+/// holds it: open addressing with every slot stamped with the insertion it belongs to,
+/// so the table is never cleared.
+#[derive(Clone, Debug, Default)]
+struct EdgeTable {
+    slots: Vec<EdgeSlot>,
+    stamp: u32,
+    shift: u32,
+}
+
+#[derive(Copy, Clone, Debug)]
+struct EdgeSlot {
+    key: u64,
+    stamp: u32,
+    face: FaceRef,
+}
+
+impl EdgeTable {
+    /// Starts a new insertion with `faces` boundary faces; returns its stamp.
+    fn start(&mut self, faces: usize) -> u32 {
+        // Three directed edges per face; 16 slots per face keep the load under 3/16,
+        // so that most probes hit at once.
+        let want = (faces * 16).next_power_of_two().max(256);
+        if want > self.slots.len() || self.stamp == u32::MAX {
+            let empty = EdgeSlot {
+                key: 0,
+                stamp: 0,
+                face: FaceRef(0),
+            };
+            self.slots = vec![empty; want.max(self.slots.len())];
+            self.shift = 64 - self.slots.len().trailing_zeros();
+            self.stamp = 0;
+        }
+        self.stamp += 1;
+        self.stamp
+    }
+
+    #[inline(always)]
+    fn home(&self, key: u64) -> usize {
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> self.shift) as usize
+    }
+
+    /// Files the directed edge `(a, b)` as held by face `face`.
+    #[inline]
+    fn insert(&mut self, stamp: u32, a: VertexId, b: VertexId, face: FaceRef) {
+        let key = u64::from(a) << 32 | u64::from(b);
+        let mask = self.slots.len() - 1;
+        let mut h = self.home(key);
+        while self.slots[h].stamp == stamp {
+            h = (h + 1) & mask;
+        }
+        self.slots[h] = EdgeSlot { key, stamp, face };
+    }
+
+    /// The face filed with the directed edge `(a, b)`, if any.
+    #[inline]
+    fn find(&self, stamp: u32, a: VertexId, b: VertexId) -> Option<FaceRef> {
+        let key = u64::from(a) << 32 | u64::from(b);
+        let mask = self.slots.len() - 1;
+        let mut h = self.home(key);
+        loop {
+            let s = &self.slots[h];
+            if s.stamp != stamp {
+                return None;
+            }
+            if s.key == key {
+                return Some(s.face);
+            }
+            h = (h + 1) & mask;
+        }
+    }
+}
+
+/// The smallest box holding `points` (an empty box for no points).
+fn bounding_box(points: &[Point]) -> [Point; 2] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    [lo, hi]
 }
 
 /// Exact collinearity: all three axis-aligned projections have zero area.
@@ -429,11 +558,83 @@ fn collinear(a: &Point, b: &Point, c: &Point) -> bool {
 #[cfg(test)]
 mod tests;
 
+mod steiner;
+
+/// A finished triangulation in output form (see [`Delaunay::export_with`]).
+#[derive(Clone, Debug, Default)]
+pub struct Exported {
+    /// The live real tets as quadruples of input indices, numbered compactly in slot order.
+    pub tets: Vec<[u32; 4]>,
+    /// For each tet, its neighbours across faces 0..4 (-1 across hull faces); empty
+    /// unless asked for.
+    pub neighbors: Vec<[i64; 4]>,
+    /// The hull faces as input indices, oriented outwards (seen from outside, counter-
+    /// clockwise), in the order of their tets and, within a tet, of their faces.
+    pub hull_faces: Vec<[u32; 3]>,
+}
+
 impl Delaunay {
     /// The live real tets as quadruples of input indices (compactly numbered) and, for
     /// each, the numbers of its neighbours across faces 0..4 (-1 across hull faces).
     /// Consumes the triangulation so that its memory can be reused for the numbering.
-    pub fn export(mut self) -> (Vec<[u32; 4]>, Vec<[i64; 4]>) {
+    pub fn export(self) -> (Vec<[u32; 4]>, Vec<[i64; 4]>) {
+        let e = self.export_with(true);
+        (e.tets, e.neighbors)
+    }
+
+    /// The triangulation in output form, with the neighbour table only if `neighbors`.
+    ///
+    /// Without neighbours the tet arena is turned into the tet list in place (Rust's
+    /// in-place collect reuses the allocation), so no memory is touched for the first
+    /// time: on a million points that saves a quarter of a gigabyte of page faults.
+    pub fn export_with(self, neighbors: bool) -> Exported {
+        if neighbors {
+            return self.export_with_neighbors();
+        }
+        let Delaunay {
+            mesh,
+            orig,
+            mut mark,
+            ..
+        } = self;
+        // Bit f of mark[t]: face f of real tet t is on the hull (faces a ghost).
+        mark.clear();
+        mark.resize(mesh.num_slots(), 0);
+        for t in mesh.live_tets() {
+            if mesh.is_ghost(t) {
+                let f = mesh.adj(FaceRef::new(t, 3));
+                mark[f.tet() as usize] |= 1 << f.face();
+            }
+        }
+        let mut hull_faces = Vec::new();
+        let mut tets: Vec<[u32; 4]> = mesh
+            .into_tets()
+            .into_iter()
+            .enumerate()
+            .filter(|(_, t)| t.is_real())
+            .map(|(i, t)| {
+                let v = t.v.map(|x| orig[x as usize]);
+                let m = mark[i];
+                if m != 0 {
+                    for (f, fv) in FACE_VERTS.iter().enumerate() {
+                        if m & (1 << f) != 0 {
+                            hull_faces.push([v[fv[0]], v[fv[2]], v[fv[1]]]);
+                        }
+                    }
+                }
+                v
+            })
+            .collect();
+        // Gives the arena's unused tail back (a remap, not a copy).
+        tets.shrink_to_fit();
+        Exported {
+            tets,
+            neighbors: Vec::new(),
+            hull_faces,
+        }
+    }
+
+    fn export_with_neighbors(mut self) -> Exported {
         self.mark = Vec::new();
         let mut number = vec![0u32; self.mesh.num_slots()];
         let mut count = 0u32;
@@ -443,17 +644,26 @@ impl Delaunay {
         }
         let mut tets = Vec::with_capacity(count as usize);
         let mut neighbors = Vec::with_capacity(count as usize);
+        let mut hull_faces = Vec::new();
         for t in self.mesh.real_tets() {
-            tets.push(self.mesh.verts(t).map(|v| self.orig[v as usize]));
+            let v = self.mesh.verts(t).map(|v| self.orig[v as usize]);
+            tets.push(v);
             let mut nb = [-1i64; 4];
             for (i, slot) in nb.iter_mut().enumerate() {
                 let n = self.mesh.adj(FaceRef::new(t, i)).tet();
-                if !self.mesh.is_ghost(n) {
+                if self.mesh.is_ghost(n) {
+                    let fv = FACE_VERTS[i];
+                    hull_faces.push([v[fv[0]], v[fv[2]], v[fv[1]]]);
+                } else {
                     *slot = i64::from(number[n as usize]);
                 }
             }
             neighbors.push(nb);
         }
-        (tets, neighbors)
+        Exported {
+            tets,
+            neighbors,
+            hull_faces,
+        }
     }
 }

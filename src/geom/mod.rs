@@ -3,4 +3,4 @@
 pub mod hilbert;
 pub mod predicates;
 
-pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign};
+pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign, StaticFilter};

@@ -140,6 +140,86 @@ pub fn insphere(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
     -robust::insphere(c(a), c(b), c(c_), c(d), c(e))
 }
 
+/// Static error bounds for [`orient3d`] and [`insphere`] on points inside a fixed
+/// bounding box: one comparison settles almost every test, without the per-call bound.
+///
+/// The bounds are the semi-static ones evaluated at the box's extents, which bound every
+/// coordinate difference of points in the box (rounding is monotone), so they are never
+/// smaller than the bound a call would compute. Outside the range where that analysis
+/// holds they are infinite, and every test falls through to the per-call filter.
+#[derive(Copy, Clone, Debug)]
+pub struct StaticFilter {
+    o3d: f64,
+    isp: f64,
+}
+
+impl StaticFilter {
+    /// Bounds for points with `lo <= p <= hi` componentwise.
+    pub fn new(lo: &Point, hi: &Point) -> Self {
+        let (dx, dy, dz) = (hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+        let usable = |b: f64| {
+            if b > FILTER_MIN && b < FILTER_MAX {
+                b
+            } else {
+                f64::INFINITY
+            }
+        };
+        StaticFilter {
+            o3d: usable(O3D_FILTER * (dx * dy * dz)),
+            isp: usable(ISP_FILTER * ((dx * dx + dy * dy + dz * dz) * (dx * dy * dz))),
+        }
+    }
+
+    /// [`orient3d`] for points in the box.
+    #[inline(always)]
+    pub fn orient3d(&self, a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
+        let (adx, ady, adz) = (a[0] - d[0], a[1] - d[1], a[2] - d[2]);
+        let (bdx, bdy, bdz) = (b[0] - d[0], b[1] - d[1], b[2] - d[2]);
+        let (cdx, cdy, cdz) = (c_[0] - d[0], c_[1] - d[1], c_[2] - d[2]);
+        let det = adz * (bdx * cdy - cdx * bdy)
+            + bdz * (cdx * ady - adx * cdy)
+            + cdz * (adx * bdy - bdx * ady);
+        if det > self.o3d || -det > self.o3d {
+            return -det;
+        }
+        orient3d(a, b, c_, d)
+    }
+
+    /// [`insphere`] for points in the box.
+    #[inline(always)]
+    pub fn insphere(&self, a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
+        let det = insphere_det(a, b, c_, d, e);
+        if det > self.isp || -det > self.isp {
+            return -det;
+        }
+        insphere(a, b, c_, d, e)
+    }
+}
+
+/// The floating-point value of Shewchuk's insphere determinant (unfiltered).
+#[inline(always)]
+fn insphere_det(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
+    let (aex, aey, aez) = (a[0] - e[0], a[1] - e[1], a[2] - e[2]);
+    let (bex, bey, bez) = (b[0] - e[0], b[1] - e[1], b[2] - e[2]);
+    let (cex, cey, cez) = (c_[0] - e[0], c_[1] - e[1], c_[2] - e[2]);
+    let (dex, dey, dez) = (d[0] - e[0], d[1] - e[1], d[2] - e[2]);
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
+    let abc = aez * bc - bez * ac + cez * ab;
+    let bcd = bez * cd - cez * bd + dez * bc;
+    let cda = cez * da + dez * ac + aez * cd;
+    let dab = dez * ab + aez * bd + bez * da;
+    let alift = aex * aex + aey * aey + aez * aez;
+    let blift = bex * bex + bey * bey + bez * bez;
+    let clift = cex * cex + cey * cey + cez * cez;
+    let dlift = dex * dex + dey * dey + dez * dez;
+    (dlift * abc - clift * dab) + (blift * cda - alift * bcd)
+}
+
 /// Insphere with ties broken by TetGen's symbolic perturbation.
 ///
 /// `ids` are the points' perturbation indices (input order; Steiner points come later).

@@ -34,10 +34,12 @@ use crate::error::Error;
 use crate::options::Options;
 use crate::output::MeshOut;
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::cell::OnceCell;
 use std::ffi::{OsStr, OsString};
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
 use thiserror::Error as ThisError;
 
 /// One kind of output file.
@@ -254,8 +256,9 @@ pub fn write_files(
     let mut temps: Vec<PathBuf> = Vec::with_capacity(kinds.len());
     let mut renamed = 0;
     let result = (|| -> Result<(), Error> {
-        // Derived once, shared by the .face/.edge writers.
-        let derived = Derived::new(mesh);
+        // Derived at most once, shared by the .face/.edge/.neigh writers, and only if
+        // one of them needs it: deriving neighbours sorts every face of the mesh.
+        let derived = OnceCell::new();
         for (&kind, fin) in kinds.iter().zip(&finals) {
             on_file(fin);
             let tmp = temp_path(fin);
@@ -336,23 +339,26 @@ pub fn write_kind<W: Write>(
     mesh: &MeshOut,
     w: &WriteOptions,
 ) -> io::Result<()> {
-    let derived = Derived::new(mesh);
-    write_kind_with(out, kind, mesh, w, &derived)
+    write_kind_with(out, kind, mesh, w, &OnceCell::new())
 }
 
-fn write_kind_with<W: Write>(
+fn write_kind_with<'a, W: Write>(
     out: &mut W,
     kind: FileKind,
-    mesh: &MeshOut,
+    mesh: &'a MeshOut,
     w: &WriteOptions,
-    d: &Derived<'_>,
+    d: &OnceCell<Derived<'a>>,
 ) -> io::Result<()> {
+    let d = || d.get_or_init(|| Derived::new(mesh));
     match kind {
         FileKind::Node => write_node(out, mesh, w),
         FileKind::Ele => write_ele(out, mesh, w),
-        FileKind::Face => write_face(out, mesh, w, d),
-        FileKind::Edge => write_edge(out, mesh, w, d),
-        FileKind::Neigh => write_neigh(out, mesh, w, d),
+        FileKind::Face if !w.all_faces && !mesh.plc_mode && !mesh.hull_faces.is_empty() => {
+            write_hull_faces(out, mesh, w)
+        }
+        FileKind::Face => write_face(out, mesh, w, d()),
+        FileKind::Edge => write_edge(out, mesh, w, d()),
+        FileKind::Neigh => write_neigh(out, mesh, w, d()),
     }
 }
 
@@ -367,25 +373,25 @@ pub fn write_node<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io
     b.str("  ");
     b.int(i64::from(mesh.point_markers.is_some()), 0);
     b.nl()?;
-    for (i, p) in mesh.points.iter().enumerate() {
-        b.int(base + i as i64, 4);
-        b.str("   ");
-        for &x in p {
-            b.str(" ");
-            b.float(x);
-            b.str(" ");
+    b.records(mesh.points.len(), |t, i| {
+        t.int(base + i as i64, 4);
+        t.str("   ");
+        for &x in &mesh.points[i] {
+            t.str(" ");
+            t.float(x);
+            t.str(" ");
         }
-        b.trim_one_space();
+        t.trim_one_space();
         for k in 0..na {
-            b.str("  ");
-            b.float(mesh.point_attrs.get(i * na + k).copied().unwrap_or(0.0));
+            t.str("  ");
+            t.float(mesh.point_attrs.get(i * na + k).copied().unwrap_or(0.0));
         }
         if let Some(m) = &mesh.point_markers {
-            b.str("    ");
-            b.int(i64::from(m.get(i).copied().unwrap_or(0)), 0);
+            t.str("    ");
+            t.int(i64::from(m.get(i).copied().unwrap_or(0)), 0);
         }
-        b.nl()?;
-    }
+        t.end_line();
+    })?;
     b.comment(w)?;
     b.finish()
 }
@@ -399,17 +405,39 @@ pub fn write_ele<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io:
     b.str("  4  ");
     b.int(na as i64, 0);
     b.nl()?;
-    for (i, t) in mesh.tets.iter().enumerate() {
-        b.int(base + i as i64, 5);
-        b.str("  ");
-        for &v in t {
-            b.str(" ");
-            b.int(base + i64::from(v), 5);
+    b.records(mesh.tets.len(), |t, i| {
+        t.int(base + i as i64, 5);
+        t.str("  ");
+        for &v in &mesh.tets[i] {
+            t.str(" ");
+            t.int(base + i64::from(v), 5);
         }
         for k in 0..na {
-            b.str("    ");
-            b.float(mesh.tet_attrs.get(i * na + k).copied().unwrap_or(0.0));
+            t.str("    ");
+            t.float(mesh.tet_attrs.get(i * na + k).copied().unwrap_or(0.0));
         }
+        t.end_line();
+    })?;
+    b.comment(w)?;
+    b.finish()
+}
+
+/// Writes the `.face` file of a point set from `mesh.hull_faces` (the same lines as
+/// [`write_face`] derives from the neighbours).
+fn write_hull_faces<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io::Result<()> {
+    let base = w.base(mesh.first_index);
+    let mut b = LineBuf::new(out);
+    b.int(mesh.hull_faces.len() as i64, 0);
+    b.str("  0");
+    b.nl()?;
+    for (i, f) in mesh.hull_faces.iter().enumerate() {
+        b.int(base + i as i64, 5);
+        b.str("   ");
+        b.int(base + i64::from(f[0]), 4);
+        b.str("  ");
+        b.int(base + i64::from(f[1]), 4);
+        b.str("  ");
+        b.int(base + i64::from(f[2]), 4);
         b.nl()?;
     }
     b.comment(w)?;
@@ -789,17 +817,15 @@ fn sorted2(e: [u32; 2]) -> [u32; 2] {
     }
 }
 
-/// Builds lines in a byte buffer and hands it to the writer in large chunks.
-struct LineBuf<'w, W: Write> {
-    out: &'w mut W,
+/// Text being formatted: a byte buffer and the float formatter's scratch.
+struct Text {
     buf: Vec<u8>,
     ryu: ryu::Buffer,
 }
 
-impl<'w, W: Write> LineBuf<'w, W> {
-    fn new(out: &'w mut W) -> Self {
-        LineBuf {
-            out,
+impl Text {
+    fn new() -> Self {
+        Text {
             buf: Vec::with_capacity(1 << 16),
             ryu: ryu::Buffer::new(),
         }
@@ -807,6 +833,10 @@ impl<'w, W: Write> LineBuf<'w, W> {
 
     fn str(&mut self, s: &str) {
         self.buf.extend_from_slice(s.as_bytes());
+    }
+
+    fn end_line(&mut self) {
+        self.buf.push(b'\n');
     }
 
     /// Removes one trailing space (after the last of a run of space-separated fields).
@@ -854,15 +884,117 @@ impl<'w, W: Write> LineBuf<'w, W> {
             self.buf.extend_from_slice(b"-inf");
         }
     }
+}
+
+/// Builds lines in a byte buffer and hands it to the writer in large chunks.
+struct LineBuf<'w, W: Write> {
+    out: &'w mut W,
+    text: Text,
+}
+
+impl<W: Write> std::ops::Deref for LineBuf<'_, W> {
+    type Target = Text;
+    fn deref(&self) -> &Text {
+        &self.text
+    }
+}
+
+impl<W: Write> std::ops::DerefMut for LineBuf<'_, W> {
+    fn deref_mut(&mut self) -> &mut Text {
+        &mut self.text
+    }
+}
+
+/// Records per block when formatting in parallel (about a megabyte of text).
+const BLOCK: usize = 1 << 15;
+
+impl<'w, W: Write> LineBuf<'w, W> {
+    fn new(out: &'w mut W) -> Self {
+        LineBuf {
+            out,
+            text: Text::new(),
+        }
+    }
 
     /// Ends the line, passing the buffer on when it is large.
     fn nl(&mut self) -> io::Result<()> {
-        self.buf.push(b'\n');
-        if self.buf.len() >= (1 << 16) - 256 {
-            self.out.write_all(&self.buf)?;
-            self.buf.clear();
+        self.text.end_line();
+        if self.text.buf.len() >= (1 << 16) - 256 {
+            self.out.write_all(&self.text.buf)?;
+            self.text.buf.clear();
         }
         Ok(())
+    }
+
+    /// Appends records `0..count`, each formatted (with its line end) by `line`.
+    ///
+    /// Formatting numbers is most of the cost of writing a big mesh, so large files are
+    /// formatted by two threads in alternating blocks while this one writes the blocks
+    /// in order; the bytes are the same as formatting them one by one.
+    fn records(&mut self, count: usize, line: impl Fn(&mut Text, usize) + Sync) -> io::Result<()> {
+        let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(2));
+        self.records_on(workers, count, line)
+    }
+
+    /// [`Self::records`] with `workers` formatting threads (one means this thread alone).
+    fn records_on(
+        &mut self,
+        workers: usize,
+        count: usize,
+        line: impl Fn(&mut Text, usize) + Sync,
+    ) -> io::Result<()> {
+        if workers < 2 || count < 4 * BLOCK {
+            for i in 0..count {
+                line(&mut self.text, i);
+                if self.text.buf.len() >= (1 << 16) - 256 {
+                    self.out.write_all(&self.text.buf)?;
+                    self.text.buf.clear();
+                }
+            }
+            return Ok(());
+        }
+        self.out.write_all(&self.text.buf)?;
+        self.text.buf.clear();
+        let blocks = count.div_ceil(BLOCK);
+        let out = &mut *self.out;
+        let line = &line;
+        std::thread::scope(|scope| {
+            // Per worker: a channel of formatted blocks to write and one returning the
+            // written buffers for reuse (two in flight, so a worker runs one block ahead).
+            let mut lanes = Vec::with_capacity(workers);
+            for lane in 0..workers {
+                let (full_tx, full_rx) = mpsc::sync_channel::<Vec<u8>>(1);
+                let (empty_tx, empty_rx) = mpsc::channel::<Vec<u8>>();
+                for _ in 0..2 {
+                    let _ = empty_tx.send(Vec::new());
+                }
+                scope.spawn(move || {
+                    let mut text = Text::new();
+                    for b in (lane..blocks).step_by(workers) {
+                        let Ok(buf) = empty_rx.recv() else { return };
+                        text.buf = buf;
+                        text.buf.clear();
+                        for i in b * BLOCK..((b + 1) * BLOCK).min(count) {
+                            line(&mut text, i);
+                        }
+                        if full_tx.send(std::mem::take(&mut text.buf)).is_err() {
+                            return;
+                        }
+                    }
+                });
+                lanes.push((full_rx, empty_tx));
+            }
+            // Returning early drops the channels, which stops the workers.
+            for b in 0..blocks {
+                let (full_rx, empty_tx) = &lanes[b % workers];
+                let buf = full_rx
+                    .recv()
+                    .map_err(|_| io::Error::other("a formatting thread failed"))?;
+                out.write_all(&buf)?;
+                let _ = empty_tx.send(buf);
+            }
+            Ok(())
+        })
     }
 
     /// The closing comment line, if any (newlines in it become spaces).
@@ -880,8 +1012,8 @@ impl<'w, W: Write> LineBuf<'w, W> {
     }
 
     fn finish(mut self) -> io::Result<()> {
-        self.out.write_all(&self.buf)?;
-        self.buf.clear();
+        self.out.write_all(&self.text.buf)?;
+        self.text.buf.clear();
         self.out.flush()
     }
 }
@@ -1137,6 +1269,32 @@ mod tests {
         };
         assert!(render(FileKind::Neigh, &m, &w).contains("   1      -1    -1    -1     2\n"));
         assert!(render(FileKind::Face, &m, &w).starts_with("6  0\n"));
+    }
+
+    /// Records formatted by worker threads come out exactly as formatted in order.
+    #[test]
+    fn parallel_records_match_sequential_ones() {
+        let count = 5 * BLOCK + 17;
+        let line = |t: &mut Text, i: usize| {
+            t.int(i as i64, 6);
+            t.str(" ");
+            t.float(i as f64 / 7.0);
+            t.end_line();
+        };
+        let render = |workers: usize| {
+            let mut out = Vec::new();
+            let mut b = LineBuf::new(&mut out);
+            b.str("head\n");
+            b.records_on(workers, count, line).unwrap();
+            b.str("tail\n");
+            b.finish().unwrap();
+            out
+        };
+        let one = render(1);
+        assert!(one.starts_with(b"head\n     0 0\n     1 0.14285714285714285\n"));
+        assert!(one.ends_with(b"\n163856 23408\ntail\n"));
+        assert_eq!(one, render(2));
+        assert_eq!(one, render(3));
     }
 
     #[test]

@@ -59,6 +59,14 @@ pub struct Tet {
     pub adj: [FaceRef; 4],
 }
 
+impl Tet {
+    /// True for a live tet that is not a ghost (false for ghosts and free slots).
+    #[inline(always)]
+    pub fn is_real(&self) -> bool {
+        self.v[0] != DEAD && self.v[3] != GHOST
+    }
+}
+
 /// The tet arena with a free list and a vertex-to-tet map.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -160,6 +168,16 @@ impl Mesh {
         Ok(t)
     }
 
+    /// Overwrites live tet `t` with a tet of vertices `v` and unset links, in place (an
+    /// insertion reuses the slots of the tets it deletes, which are hot in cache).
+    #[inline]
+    pub fn reset_tet(&mut self, t: TetId, v: [VertexId; 4]) {
+        self.tets[t as usize] = Tet {
+            v,
+            adj: [FaceRef(u32::MAX); 4],
+        };
+    }
+
     /// Points every vertex at one of its live tets. Bulk construction leaves the map
     /// stale because updating it per tet costs random writes; call this afterwards.
     pub fn rebuild_vertex_map(&mut self) {
@@ -208,6 +226,11 @@ impl Mesh {
         let v = &self.tets[t as usize].v;
         let f = FACE_VERTS[i];
         [v[f[0]], v[f[1]], v[f[2]]]
+    }
+
+    /// The tet slots, free ones included (see [`Tet::is_real`]), consuming the mesh.
+    pub fn into_tets(self) -> Vec<Tet> {
+        self.tets
     }
 
     /// Iterates over the ids of live tets, ghosts included.

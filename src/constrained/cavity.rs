@@ -1,0 +1,808 @@
+//! Facet insertion by cavity retriangulation (Si & Gärtner; the paper's §3.1).
+//!
+//! A missing region R (triangles of one facet that are not mesh faces) is inserted by
+//! removing the tets that cross it, splitting their union into the cavities above and
+//! below R, and filling each with the Delaunay tetrahedralization of its vertices. A
+//! cavity face missing from that tetrahedralization makes the cavity grow by the tet
+//! outside that face, until every face is present. The mesh is only changed once both
+//! sides have been triangulated, so a failure leaves it as it was.
+//!
+//! Polygons that are not exactly flat can make the two sides disagree on R, or leave a
+//! shim tet (four vertices on R); then the region asks for a Steiner point on the
+//! polygon instead.
+
+use super::cdt::{face_key, Cdt};
+use crate::delaunay::Delaunay;
+use crate::error::MeshError;
+use crate::geom::{orient3d, Point};
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS, GHOST};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Figures of one region insertion (rows of the paper's Table 1).
+#[derive(Clone, Debug, Default)]
+pub struct RegionStats {
+    /// Facets whose subfaces the retriangulation destroyed; they must be inserted again.
+    pub lost: Vec<u32>,
+    /// Tets crossing the region, deleted.
+    pub crossing_tets: usize,
+    /// Tets added to the cavity because a cavity face was missing.
+    pub enlarged_tets: usize,
+    /// Subfaces recovered (triangles of the region).
+    pub subfaces: usize,
+}
+
+/// What inserting a region did.
+#[derive(Clone, Debug)]
+pub enum Outcome {
+    /// The region is now a union of mesh faces.
+    Inserted(RegionStats),
+    /// The polygon is not flat enough: a Steiner point on it, here, resolves the conflict.
+    NeedsSteiner(Point),
+    /// The retriangulation would lose this subsegment (not Delaunay among the cavity's
+    /// vertices): splitting it protects it.
+    SplitSubsegment(VertexId, VertexId),
+}
+
+/// The boundary faces of a cavity above and below its region.
+type Sides = (Vec<CavFace>, Vec<CavFace>);
+
+/// The 6 edges of a tet as pairs of slots.
+const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// A face of the cavity boundary: the inward-oriented vertices and, for faces of the
+/// mesh, the tet inside the cavity and its face index.
+#[derive(Clone, Copy, Debug)]
+struct CavFace {
+    verts: [VertexId; 3],
+    inner: Option<FaceRef>,
+}
+
+/// Inserts the region `tris` (counterclockwise seen from the facet's normal side) of
+/// facet `facet` into the mesh.
+pub fn insert_region(
+    cdt: &mut Cdt,
+    tris: &[[VertexId; 3]],
+    facet: u32,
+    normal: [f64; 3],
+) -> Result<Outcome, MeshError> {
+    let region = Region::new(cdt, tris);
+    let mut cavity = crossing_tets(cdt, &region);
+    if cavity.is_empty() {
+        // No tet crosses the region, yet its triangles are missing: the mesh already
+        // triangulates the (not exactly flat) region its own way, which is as good a
+        // triangulation of the polygon as ours.
+        return match adopt(cdt, &region, normal) {
+            Some(faces) => {
+                let n = faces.len();
+                for f in faces {
+                    cdt.subfaces.insert(face_key(f), facet);
+                }
+                Ok(Outcome::Inserted(RegionStats {
+                    subfaces: n,
+                    ..Default::default()
+                }))
+            }
+            None => Ok(Outcome::NeedsSteiner(circumcenter(cdt, tris[0]))),
+        };
+    }
+    let crossing = cavity.len();
+    let mut in_cav: FxHashSet<TetId> = cavity.iter().copied().collect();
+    let Some((mut top, mut bottom)) = split_sides(cdt, &region, &in_cav)? else {
+        return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
+    };
+    let mut enlarged = 0;
+    let mut sides: [Option<SideDt>; 2] = [None, None];
+    #[allow(clippy::needless_range_loop)] // `side` also selects the face list and lid
+    for side in 0..2 {
+        loop {
+            let (faces, lid_flip) = if side == 0 {
+                (&top, false)
+            } else {
+                (&bottom, true)
+            };
+            let all = side_faces(faces, &region, lid_flip);
+            let sdt = delaunay_of(cdt, &all)?;
+            let missing = sdt.missing(&all);
+            if missing.is_empty() {
+                sides[side] = Some(sdt);
+                break;
+            }
+            for m in missing {
+                let Some(inner) = all[m].inner else {
+                    // A triangle of R is not a face: the sides disagree on R.
+                    return Ok(Outcome::NeedsSteiner(circumcenter(cdt, all[m].verts)));
+                };
+                let outside = cdt.dt.mesh.adj(inner).tet();
+                if in_cav.contains(&outside) {
+                    continue;
+                }
+                if cdt.is_ghost(outside) {
+                    return Err(MeshError::Internal(format!(
+                        "facet {facet}: a hull face is missing from a cavity triangulation"
+                    )));
+                }
+                grow(cdt, outside, side, &mut in_cav, &mut top, &mut bottom)?;
+                cavity.push(outside);
+                enlarged += 1;
+            }
+        }
+    }
+    let [Some(dt_top), Some(dt_bot)] = sides else {
+        return Err(MeshError::Internal(
+            "a cavity side was not triangulated".into(),
+        ));
+    };
+    // Growing the bottom side never touches the top side's faces (`grow` refuses to),
+    // so the top side's triangulation still holds.
+    let top_faces = side_faces(&top, &region, false);
+    let bot_faces = side_faces(&bottom, &region, true);
+    let mut new_tets = Vec::new();
+    for (sdt, faces) in [(&dt_top, &top_faces), (&dt_bot, &bot_faces)] {
+        for v in sdt.inside(faces)? {
+            if v.iter().all(|x| region.verts.contains(x)) {
+                // A shim tet: four vertices on the polygon.
+                let f = [v[0], v[1], v[2]];
+                return Ok(Outcome::NeedsSteiner(circumcenter(cdt, f)));
+            }
+            new_tets.push(v);
+        }
+    }
+    // Subsegments inside the cavity must survive: the new tets have no constraints.
+    let mut new_edges: FxHashSet<(VertexId, VertexId)> = FxHashSet::default();
+    for v in &new_tets {
+        for &(i, j) in &EDGES {
+            new_edges.insert((v[i].min(v[j]), v[i].max(v[j])));
+        }
+    }
+    for &t in &cavity {
+        let v = cdt.dt.mesh.verts(t);
+        for &(i, j) in &EDGES {
+            let e = (v[i].min(v[j]), v[i].max(v[j]));
+            if cdt.subsegs.contains_key(&e) && !new_edges.contains(&e) {
+                return Ok(Outcome::SplitSubsegment(e.0, e.1));
+            }
+        }
+    }
+    // Subfaces among the faces of the deleted tets may not survive the new triangulation.
+    let mut at_risk: Vec<[VertexId; 3]> = Vec::new();
+    for &t in &cavity {
+        for i in 0..4 {
+            let v = cdt.dt.mesh.face_verts(t, i);
+            let key = face_key(v);
+            if cdt.subfaces.contains_key(&key) {
+                at_risk.push(key);
+            }
+        }
+    }
+    graft(cdt, &cavity, &top_faces, &bot_faces, &new_tets)?;
+    let mut lost = Vec::new();
+    at_risk.sort_unstable();
+    at_risk.dedup();
+    for key in at_risk {
+        if cdt.find_face(key[0], key[1], key[2]).is_none() {
+            if let Some(f) = cdt.subfaces.remove(&key) {
+                lost.push(f);
+            }
+        }
+    }
+    for t in tris {
+        cdt.subfaces.insert(face_key(*t), facet);
+    }
+    lost.sort_unstable();
+    lost.dedup();
+    Ok(Outcome::Inserted(RegionStats {
+        lost,
+        crossing_tets: crossing,
+        enlarged_tets: enlarged,
+        subfaces: tris.len(),
+    }))
+}
+
+/// The mesh faces that triangulate the region when no tet crosses it: a flood over mesh
+/// faces with all vertices on the region, from its boundary edges inward (sides told
+/// apart in the facet's projection). `None` if they do not make up a triangulation of it.
+fn adopt(cdt: &mut Cdt, region: &Region, normal: [f64; 3]) -> Option<Vec<[VertexId; 3]>> {
+    let axis = (0..3).max_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))?;
+    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+    let o2 = |a: VertexId, b: VertexId, c: VertexId| {
+        let p = |v: VertexId| {
+            let q = cdt.dt.points[v as usize];
+            robust::Coord { x: q[u], y: q[w] }
+        };
+        robust::orient2d(p(a), p(b), p(c))
+    };
+    // Candidate faces around every region vertex.
+    let mut cand: FxHashSet<[VertexId; 3]> = FxHashSet::default();
+    let mut star = Vec::new();
+    for &v in &region.verts {
+        cdt.dt.star(v, &mut star);
+        for &t in &star {
+            let tv = cdt.dt.mesh.verts(t);
+            if tv.iter().all(|x| region.verts.contains(x)) {
+                return None; // a shim tet
+            }
+            for fv in FACE_VERTS {
+                let f = [tv[fv[0]], tv[fv[1]], tv[fv[2]]];
+                if f.iter().all(|x| region.verts.contains(x)) {
+                    cand.insert(face_key(f));
+                }
+            }
+        }
+    }
+    let mut by_edge: FxHashMap<(VertexId, VertexId), Vec<[VertexId; 3]>> = FxHashMap::default();
+    for f in &cand {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(*f);
+        }
+    }
+    // The candidate through edge ab on the side of c (or away from it).
+    let pick = |a: VertexId, b: VertexId, c: VertexId, same: bool| -> Option<[VertexId; 3]> {
+        let sc = o2(a, b, c);
+        let list = by_edge.get(&(a.min(b), a.max(b)))?;
+        let mut found = None;
+        for f in list {
+            let x = *f.iter().find(|&&x| x != a && x != b)?;
+            let sx = o2(a, b, x);
+            let ok = if same { sx * sc > 0.0 } else { sx * sc < 0.0 };
+            if ok {
+                if found.is_some() {
+                    return None; // two faces on one side: not a surface
+                }
+                found = Some(*f);
+            }
+        }
+        found
+    };
+    let mut chosen: FxHashSet<[VertexId; 3]> = FxHashSet::default();
+    let mut stack = Vec::new();
+    for t in &region.tris {
+        for k in 0..3 {
+            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            if region.boundary.contains(&(a.min(b), a.max(b))) {
+                let f = pick(a, b, c, true)?;
+                if chosen.insert(f) {
+                    stack.push(f);
+                }
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        for k in 0..3 {
+            let (a, b, c) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+            if region.boundary.contains(&(a.min(b), a.max(b))) {
+                continue;
+            }
+            let g = pick(a, b, c, false)?;
+            if chosen.insert(g) {
+                stack.push(g);
+                if chosen.len() > region.tris.len() {
+                    return None;
+                }
+            }
+        }
+    }
+    (chosen.len() == region.tris.len()).then(|| chosen.into_iter().collect())
+}
+
+/// The region's triangles, vertices and boundary edges.
+struct Region {
+    tris: Vec<[VertexId; 3]>,
+    verts: FxHashSet<VertexId>,
+    boundary: FxHashSet<(VertexId, VertexId)>,
+    boxes: Vec<[[f64; 3]; 2]>,
+}
+
+impl Region {
+    fn new(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Self {
+        let mut count: FxHashMap<(VertexId, VertexId), u32> = FxHashMap::default();
+        let mut verts = FxHashSet::default();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                verts.insert(a);
+            }
+        }
+        let boundary = count
+            .into_iter()
+            .filter(|&(_, c)| c == 1)
+            .map(|(e, _)| e)
+            .collect();
+        let boxes = tris
+            .iter()
+            .map(|t| {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for &v in t {
+                    let p = cdt.dt.points[v as usize];
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+                [lo, hi]
+            })
+            .collect();
+        Region {
+            tris: tris.to_vec(),
+            verts,
+            boundary,
+            boxes,
+        }
+    }
+
+    /// Does the open segment `pq` cross the region's interior?
+    fn crossed_by(&self, pts: &[Point], p: VertexId, q: VertexId) -> bool {
+        let (pp, pq) = (&pts[p as usize], &pts[q as usize]);
+        for (t, bx) in self.tris.iter().zip(&self.boxes) {
+            if (0..3).any(|k| pp[k].max(pq[k]) < bx[0][k] || pp[k].min(pq[k]) > bx[1][k]) {
+                continue;
+            }
+            let [a, b, c] = t.map(|v| &pts[v as usize]);
+            let o1 = orient3d(a, b, c, pp);
+            let o2 = orient3d(a, b, c, pq);
+            if !((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) {
+                continue;
+            }
+            let s = [
+                orient3d(pp, pq, a, b),
+                orient3d(pp, pq, b, c),
+                orient3d(pp, pq, c, a),
+            ];
+            let pos = s.iter().any(|&x| x > 0.0);
+            let neg = s.iter().any(|&x| x < 0.0);
+            if !(pos && neg) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// Does tet `t` have an edge crossing the region?
+fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
+    let v = cdt.dt.mesh.verts(t);
+    if v[3] == GHOST {
+        return false;
+    }
+    EDGES
+        .iter()
+        .any(|&(i, j)| region.crossed_by(&cdt.dt.points, v[i], v[j]))
+}
+
+/// The tets whose interiors meet the region: those with an edge crossing it. They are
+/// face-connected, and each touches the region near a region vertex or is reached from one.
+fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
+    let mut seen: FxHashSet<TetId> = FxHashSet::default();
+    let mut out = Vec::new();
+    let mut star = Vec::new();
+    let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
+    verts.sort_unstable();
+    for v in verts {
+        cdt.dt.star(v, &mut star);
+        for &t in &star {
+            if seen.insert(t) && crosses(cdt, region, t) {
+                out.push(t);
+            }
+        }
+    }
+    let mut k = 0;
+    while k < out.len() {
+        let t = out[k];
+        k += 1;
+        for i in 0..4 {
+            let n = cdt.dt.mesh.adj(FaceRef::new(t, i)).tet();
+            if seen.insert(n) && crosses(cdt, region, n) {
+                out.push(n);
+            }
+        }
+    }
+    out
+}
+
+/// Splits the cavity's boundary faces into those above and those below the region, by a
+/// flood fill over the cavity surface that stops at the region's boundary edges; `None`
+/// if they do not split it in two.
+fn split_sides(
+    cdt: &Cdt,
+    region: &Region,
+    in_cav: &FxHashSet<TetId>,
+) -> Result<Option<Sides>, MeshError> {
+    let mesh = &cdt.dt.mesh;
+    let mut faces: Vec<FaceRef> = Vec::new();
+    let mut index: FxHashMap<FaceRef, usize> = FxHashMap::default();
+    let mut cav: Vec<TetId> = in_cav.iter().copied().collect();
+    cav.sort_unstable();
+    for &t in &cav {
+        for i in 0..4 {
+            if !in_cav.contains(&mesh.adj(FaceRef::new(t, i)).tet()) {
+                index.insert(FaceRef::new(t, i), faces.len());
+                faces.push(FaceRef::new(t, i));
+            }
+        }
+    }
+    let mut comp = vec![usize::MAX; faces.len()];
+    let mut ncomp = 0;
+    for start in 0..faces.len() {
+        if comp[start] != usize::MAX {
+            continue;
+        }
+        comp[start] = ncomp;
+        let mut stack = vec![start];
+        while let Some(fi) = stack.pop() {
+            let f = faces[fi];
+            let v = mesh.face_verts(f.tet(), f.face());
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                if region.boundary.contains(&(a.min(b), a.max(b))) {
+                    continue;
+                }
+                let g = surface_neighbor(cdt, f, a, b, in_cav)?;
+                let gi = index[&g];
+                if comp[gi] == usize::MAX {
+                    comp[gi] = ncomp;
+                    stack.push(gi);
+                }
+            }
+        }
+        ncomp += 1;
+    }
+    if ncomp != 2 {
+        // The region's boundary does not split the cavity: part of the (not exactly
+        // flat) region is already triangulated differently by faces no tet crosses.
+        return Ok(None);
+    }
+    // Which component lies above: look at a face through a boundary edge of R.
+    let mut top_comp = None;
+    'search: for t in &region.tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if !region.boundary.contains(&(a.min(b), a.max(b))) {
+                continue;
+            }
+            for (fi, f) in faces.iter().enumerate() {
+                let v = mesh.face_verts(f.tet(), f.face());
+                if v.contains(&a) && v.contains(&b) {
+                    let x = *v.iter().find(|&&x| x != a && x != b).unwrap_or(&a);
+                    let p = |i: VertexId| &cdt.dt.points[i as usize];
+                    let o = orient3d(p(t[0]), p(t[1]), p(t[2]), p(x));
+                    if o > 0.0 {
+                        top_comp = Some(comp[fi]);
+                        break 'search;
+                    } else if o < 0.0 {
+                        top_comp = Some(1 - comp[fi]);
+                        break 'search;
+                    }
+                }
+            }
+        }
+    }
+    let Some(top_comp) = top_comp else {
+        return Ok(None);
+    };
+    let mut top = Vec::new();
+    let mut bottom = Vec::new();
+    for (fi, f) in faces.iter().enumerate() {
+        let cf = CavFace {
+            verts: mesh.face_verts(f.tet(), f.face()),
+            inner: Some(*f),
+        };
+        if comp[fi] == top_comp {
+            top.push(cf);
+        } else {
+            bottom.push(cf);
+        }
+    }
+    Ok(Some((top, bottom)))
+}
+
+/// The cavity boundary face next to boundary face `f` across its edge `ab`: turn around
+/// the edge through the tets outside the cavity until re-entering it.
+fn surface_neighbor(
+    cdt: &Cdt,
+    f: FaceRef,
+    a: VertexId,
+    b: VertexId,
+    in_cav: &FxHashSet<TetId>,
+) -> Result<FaceRef, MeshError> {
+    let mesh = &cdt.dt.mesh;
+    let mut g = mesh.adj(f);
+    for _ in 0..100_000 {
+        let t = g.tet();
+        if in_cav.contains(&t) {
+            return Ok(g);
+        }
+        // Leave t through its other face containing a and b.
+        let v = mesh.verts(t);
+        let skip = g.face();
+        let k = (0..4)
+            .find(|&k| k != skip && v[k] != a && v[k] != b)
+            .unwrap_or(skip);
+        g = mesh.adj(FaceRef::new(t, k));
+    }
+    Err(MeshError::Internal(
+        "turning around a cavity edge did not end".into(),
+    ))
+}
+
+/// The faces bounding one side: its cavity faces, and the region's triangles oriented so
+/// that the side lies on their positive side.
+fn side_faces(faces: &[CavFace], region: &Region, flip: bool) -> Vec<CavFace> {
+    let mut all = faces.to_vec();
+    for t in &region.tris {
+        let verts = if flip { [t[0], t[2], t[1]] } else { *t };
+        all.push(CavFace { verts, inner: None });
+    }
+    all
+}
+
+/// The Delaunay tetrahedralization of one side's vertices, with the map between its
+/// vertex ids and the mesh's.
+struct SideDt {
+    dt: Delaunay,
+    /// Mesh vertex id of each local internal vertex id.
+    global: Vec<VertexId>,
+    /// Local internal vertex id of each mesh vertex id of the side.
+    local: FxHashMap<VertexId, VertexId>,
+}
+
+/// The Delaunay tetrahedralization of the vertices of `faces`, numbered in global
+/// perturbation order so that its ties are broken exactly as in the mesh.
+fn delaunay_of(cdt: &Cdt, faces: &[CavFace]) -> Result<SideDt, MeshError> {
+    let mut gv: Vec<VertexId> = faces.iter().flat_map(|f| f.verts).collect();
+    gv.sort_unstable_by_key(|&v| cdt.dt.orig[v as usize]);
+    gv.dedup();
+    let pts: Vec<Point> = gv.iter().map(|&v| cdt.dt.points[v as usize]).collect();
+    let dt = Delaunay::build(&pts)?.dt;
+    let global: Vec<VertexId> = dt.orig.iter().map(|&i| gv[i as usize]).collect();
+    let local = global
+        .iter()
+        .enumerate()
+        .map(|(l, &g)| (g, l as VertexId))
+        .collect();
+    Ok(SideDt { dt, global, local })
+}
+
+impl SideDt {
+    /// The face `f` (mesh vertex ids) of this triangulation, seen from the tet on its
+    /// positive side.
+    fn face(&self, f: [VertexId; 3], star: &mut Vec<TetId>) -> Option<FaceRef> {
+        let [a, b, c] = [
+            self.local.get(&f[0])?,
+            self.local.get(&f[1])?,
+            self.local.get(&f[2])?,
+        ];
+        let (a, b, c) = (*a, *b, *c);
+        self.dt.star(a, star);
+        for &t in star.iter() {
+            let v = self.dt.mesh.verts(t);
+            if v.contains(&b) && v.contains(&c) {
+                let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c)?;
+                let fv = self.dt.mesh.face_verts(t, i);
+                let want = [a, b, c];
+                let same = (0..3).any(|r| fv == [want[r], want[(r + 1) % 3], want[(r + 2) % 3]]);
+                return Some(if same {
+                    FaceRef::new(t, i)
+                } else {
+                    self.dt.mesh.adj(FaceRef::new(t, i))
+                });
+            }
+        }
+        None
+    }
+
+    /// Indices of the faces that are not faces of this triangulation.
+    fn missing(&self, faces: &[CavFace]) -> Vec<usize> {
+        let mut star = Vec::new();
+        (0..faces.len())
+            .filter(|&i| self.face(faces[i].verts, &mut star).is_none())
+            .collect()
+    }
+
+    /// The tets inside the side bounded by `faces` (each seen with the side on its
+    /// positive side), as mesh vertex ids: a flood fill from the faces' inner tets that
+    /// never crosses them.
+    fn inside(&self, faces: &[CavFace]) -> Result<Vec<[VertexId; 4]>, MeshError> {
+        let mut star = Vec::new();
+        let mut wall: FxHashSet<FaceRef> = FxHashSet::default();
+        let mut stack = Vec::new();
+        let mut inside: FxHashSet<TetId> = FxHashSet::default();
+        for f in faces {
+            let inner = self
+                .face(f.verts, &mut star)
+                .ok_or_else(|| MeshError::Internal("a cavity face vanished".into()))?;
+            wall.insert(inner);
+            wall.insert(self.dt.mesh.adj(inner));
+            if inside.insert(inner.tet()) {
+                stack.push(inner.tet());
+            }
+        }
+        while let Some(t) = stack.pop() {
+            if self.dt.mesh.is_ghost(t) {
+                return Err(MeshError::Internal("a cavity side is not closed".into()));
+            }
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                if wall.contains(&f) {
+                    continue;
+                }
+                let n = self.dt.mesh.adj(f).tet();
+                if inside.insert(n) {
+                    stack.push(n);
+                }
+            }
+        }
+        let mut out: Vec<TetId> = inside.into_iter().collect();
+        out.sort_unstable();
+        Ok(out
+            .into_iter()
+            .map(|t| self.dt.mesh.verts(t).map(|x| self.global[x as usize]))
+            .collect())
+    }
+}
+
+/// Adds tet `t` (outside the cavity, next to side `side`) to the cavity, updating the
+/// boundary faces of both sides.
+fn grow(
+    cdt: &Cdt,
+    t: TetId,
+    side: usize,
+    in_cav: &mut FxHashSet<TetId>,
+    top: &mut Vec<CavFace>,
+    bottom: &mut Vec<CavFace>,
+) -> Result<(), MeshError> {
+    let mesh = &cdt.dt.mesh;
+    for i in 0..4 {
+        let f = FaceRef::new(t, i);
+        let g = mesh.adj(f);
+        if in_cav.contains(&g.tet()) {
+            // The face between t and the cavity is no longer on the boundary.
+            let in_top = top.iter().position(|c| c.inner == Some(g));
+            let in_bot = bottom.iter().position(|c| c.inner == Some(g));
+            match (in_top, in_bot) {
+                (Some(k), _) => {
+                    if side != 0 {
+                        return Err(MeshError::Internal(
+                            "a cavity grew around its polygon".into(),
+                        ));
+                    }
+                    top.swap_remove(k);
+                }
+                (None, Some(k)) => {
+                    if side != 1 {
+                        return Err(MeshError::Internal(
+                            "a cavity grew around its polygon".into(),
+                        ));
+                    }
+                    bottom.swap_remove(k);
+                }
+                (None, None) => {}
+            }
+        } else {
+            let cf = CavFace {
+                verts: mesh.face_verts(t, i),
+                inner: Some(f),
+            };
+            if side == 0 {
+                top.push(cf);
+            } else {
+                bottom.push(cf);
+            }
+        }
+    }
+    in_cav.insert(t);
+    Ok(())
+}
+
+/// Replaces the cavity's tets by `new_tets`, gluing them to each other and to the tets
+/// outside the cavity.
+fn graft(
+    cdt: &mut Cdt,
+    cavity: &[TetId],
+    top: &[CavFace],
+    bottom: &[CavFace],
+    new_tets: &[[VertexId; 4]],
+) -> Result<(), MeshError> {
+    // The outside face behind each cavity face, read before the cavity is deleted.
+    let mut outside: FxHashMap<[VertexId; 3], FaceRef> = FxHashMap::default();
+    for f in top.iter().chain(bottom) {
+        if let Some(inner) = f.inner {
+            outside.insert(face_key(f.verts), cdt.dt.mesh.adj(inner));
+        }
+    }
+    for &t in cavity {
+        cdt.dt.mesh.kill_tet(t);
+    }
+    let mut open: FxHashMap<[VertexId; 3], FaceRef> = FxHashMap::default();
+    let mut made = Vec::with_capacity(new_tets.len());
+    for &v in new_tets {
+        let t = cdt
+            .dt
+            .mesh
+            .add_tet(v)
+            .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
+        made.push(t);
+        for (i, fv) in FACE_VERTS.iter().enumerate() {
+            let key = face_key([v[fv[0]], v[fv[1]], v[fv[2]]]);
+            match open.remove(&key) {
+                Some(g) => cdt.dt.mesh.glue(FaceRef::new(t, i), g),
+                None => {
+                    open.insert(key, FaceRef::new(t, i));
+                }
+            }
+        }
+    }
+    for (key, f) in open {
+        let g = outside.get(&key).ok_or_else(|| {
+            MeshError::Internal(format!("a new cavity tet face {key:?} has no neighbour"))
+        })?;
+        cdt.dt.mesh.glue(f, *g);
+    }
+    for t in made {
+        for &x in &cdt.dt.mesh.verts(t) {
+            if x != GHOST {
+                cdt.dt.mesh.set_vertex_tet(x, t);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The centroid of the region's largest triangle: a point surely on the polygon.
+fn largest_centroid(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Point {
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    let area2 = |t: &[VertexId; 3]| {
+        let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+    };
+    let t = tris
+        .iter()
+        .max_by(|a, b| area2(a).total_cmp(&area2(b)))
+        .copied()
+        .unwrap_or([0; 3]);
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0)
+}
+
+/// The circumcenter of triangle `f` (an inexact construction: it only places a Steiner
+/// point, it never decides topology).
+fn circumcenter(cdt: &Cdt, f: [VertexId; 3]) -> Point {
+    let [a, b, c] = f.map(|v| cdt.dt.points[v as usize]);
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let ac = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        ab[1] * ac[2] - ab[2] * ac[1],
+        ab[2] * ac[0] - ab[0] * ac[2],
+        ab[0] * ac[1] - ab[1] * ac[0],
+    ];
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    let ab2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let ac2 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2];
+    // (|ab|² (ac × n) + |ac|² (n × ab)) / (2 |n|²)
+    let acn = [
+        ac[1] * n[2] - ac[2] * n[1],
+        ac[2] * n[0] - ac[0] * n[2],
+        ac[0] * n[1] - ac[1] * n[0],
+    ];
+    let nab = [
+        n[1] * ab[2] - n[2] * ab[1],
+        n[2] * ab[0] - n[0] * ab[2],
+        n[0] * ab[1] - n[1] * ab[0],
+    ];
+    if nn == 0.0 {
+        return [
+            (a[0] + b[0] + c[0]) / 3.0,
+            (a[1] + b[1] + c[1]) / 3.0,
+            (a[2] + b[2] + c[2]) / 3.0,
+        ];
+    }
+    std::array::from_fn(|k| a[k] + (ab2 * acn[k] + ac2 * nab[k]) / (2.0 * nn))
+}

@@ -1,0 +1,107 @@
+//! A constrained Delaunay tetrahedralization under construction: the Delaunay arena plus
+//! side tables of its constraints (subsegments and subfaces), keyed by sorted vertex ids.
+
+use crate::delaunay::Delaunay;
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS, GHOST};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Sorted key of an edge.
+#[inline]
+pub fn edge_key(a: VertexId, b: VertexId) -> (VertexId, VertexId) {
+    (a.min(b), a.max(b))
+}
+
+/// Sorted key of a triangle.
+#[inline]
+pub fn face_key(f: [VertexId; 3]) -> [VertexId; 3] {
+    let mut k = f;
+    k.sort_unstable();
+    k
+}
+
+/// The mesh and its constraints.
+#[derive(Clone, Debug)]
+pub struct Cdt {
+    /// The tetrahedralization (vertex ids are internal; `dt.orig` maps to output ids).
+    pub dt: Delaunay,
+    /// Subsegments, with the marker of their segment.
+    pub subsegs: FxHashMap<(VertexId, VertexId), i32>,
+    /// Subfaces present in the mesh, with the index of their (merged) facet.
+    pub subfaces: FxHashMap<[VertexId; 3], u32>,
+    scratch: Vec<TetId>,
+}
+
+impl Cdt {
+    /// Wraps a Delaunay tetrahedralization with empty constraint tables.
+    pub fn new(dt: Delaunay) -> Self {
+        Cdt {
+            dt,
+            subsegs: FxHashMap::default(),
+            subfaces: FxHashMap::default(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// The face `(a, b, c)` of the mesh, as seen from one of its two tets, if present.
+    pub fn find_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> Option<FaceRef> {
+        let mut star = std::mem::take(&mut self.scratch);
+        self.dt.star(a, &mut star);
+        let mut found = None;
+        for &t in &star {
+            let v = self.dt.mesh.verts(t);
+            if v.contains(&b) && v.contains(&c) {
+                let i = (0..4)
+                    .find(|&i| v[i] != a && v[i] != b && v[i] != c)
+                    .unwrap_or(0);
+                found = Some(FaceRef::new(t, i));
+                break;
+            }
+        }
+        self.scratch = star;
+        found
+    }
+
+    /// True if `u`–`v` is a mesh edge.
+    pub fn has_edge(&mut self, u: VertexId, v: VertexId) -> bool {
+        let mut star = std::mem::take(&mut self.scratch);
+        let r = self.dt.has_edge(u, v, &mut star);
+        self.scratch = star;
+        r
+    }
+
+    /// True if face `i` of tet `t` is a subface.
+    #[inline]
+    pub fn is_subface(&self, t: TetId, i: usize) -> bool {
+        if self.subfaces.is_empty() {
+            return false;
+        }
+        let v = self.dt.mesh.verts(t);
+        let f = FACE_VERTS[i];
+        self.subfaces
+            .contains_key(&face_key([v[f[0]], v[f[1]], v[f[2]]]))
+    }
+
+    /// The subfaces that are no longer faces of the mesh, grouped by facet.
+    pub fn lost_subfaces(&mut self) -> FxHashSet<u32> {
+        let keys: Vec<([VertexId; 3], u32)> = self.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
+        let mut lost = FxHashSet::default();
+        for (k, f) in keys {
+            if self.find_face(k[0], k[1], k[2]).is_none() {
+                lost.insert(f);
+                self.subfaces.remove(&k);
+            }
+        }
+        lost
+    }
+
+    /// Number of live real tets.
+    pub fn num_tets(&self) -> usize {
+        self.dt.mesh.real_tets().count()
+    }
+
+    /// True if tet `t` is a ghost.
+    #[inline]
+    pub fn is_ghost(&self, t: TetId) -> bool {
+        self.dt.mesh.verts(t)[3] == GHOST
+    }
+}
