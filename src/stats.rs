@@ -20,3 +20,148 @@ pub struct Stats {
     /// The figures of PLC meshing (`-p`), the rows of the paper's Table 1.
     pub plc: Option<crate::constrained::PlcStats>,
 }
+
+impl Stats {
+    /// The PLC figures as `(label, value)` rows, numbered like the paper's Table 1.
+    pub fn table1_rows(&self) -> Vec<(&'static str, String)> {
+        let Some(p) = &self.plc else {
+            return Vec::new();
+        };
+        let mean = if p.regions > 0 {
+            p.crossing_tets as f64 / p.regions as f64
+        } else {
+            0.0
+        };
+        vec![
+            ("(1) input vertices", p.input_points.to_string()),
+            ("(2) input polygons", p.input_polygons.to_string()),
+            ("(3) Steiner points", p.steiner_points.to_string()),
+            (
+                "    of them on polygons",
+                p.facet_steiner_points.to_string(),
+            ),
+            ("(4) output tetrahedra", p.output_tets.to_string()),
+            ("(5) output subpolygons", p.output_subfaces.to_string()),
+            (
+                "(6) recovered subpolygons",
+                p.recovered_subfaces.to_string(),
+            ),
+            (
+                "(7) most recovered in one region",
+                p.max_region_subfaces.to_string(),
+            ),
+            ("(9) crossing tetrahedra", p.crossing_tets.to_string()),
+            (
+                "(10) most crossing in one region",
+                p.max_region_crossing_tets.to_string(),
+            ),
+            ("(11) mean crossing per region", format!("{mean:.1}")),
+            ("    missing regions", p.regions.to_string()),
+            (
+                "    tets added by cavity enlargement",
+                p.enlarged_tets.to_string(),
+            ),
+            (
+                "    restarts for Steiner points on polygons",
+                p.restarts.to_string(),
+            ),
+            ("(12) Delaunay seconds", format!("{:.6}", p.delaunay_secs)),
+            (
+                "(13) segment recovery seconds",
+                format!("{:.6}", p.segment_secs),
+            ),
+            (
+                "(14) facet recovery seconds",
+                format!("{:.6}", p.facet_secs),
+            ),
+            ("    carving seconds", format!("{:.6}", p.carve_secs)),
+            ("(16) total CDT seconds", format!("{:.6}", self.total_secs)),
+        ]
+    }
+
+    /// All figures as one JSON object (for `--stats-json`).
+    pub fn to_json(&self, model: &str) -> String {
+        let mut fields: Vec<(String, String)> = vec![
+            ("model".into(), json_string(model)),
+            ("input_points".into(), self.input_points.to_string()),
+            ("duplicate_points".into(), self.duplicate_points.to_string()),
+            ("output_tets".into(), self.output_tets.to_string()),
+            ("delaunay_secs".into(), json_f64(self.delaunay_secs)),
+            ("total_secs".into(), json_f64(self.total_secs)),
+        ];
+        if let Some(p) = &self.plc {
+            let pairs: [(&str, String); 16] = [
+                ("input_polygons", p.input_polygons.to_string()),
+                ("steiner_points", p.steiner_points.to_string()),
+                ("facet_steiner_points", p.facet_steiner_points.to_string()),
+                ("output_subfaces", p.output_subfaces.to_string()),
+                ("recovered_subfaces", p.recovered_subfaces.to_string()),
+                ("max_region_subfaces", p.max_region_subfaces.to_string()),
+                ("regions", p.regions.to_string()),
+                ("crossing_tets", p.crossing_tets.to_string()),
+                (
+                    "max_region_crossing_tets",
+                    p.max_region_crossing_tets.to_string(),
+                ),
+                ("enlarged_tets", p.enlarged_tets.to_string()),
+                ("restarts", p.restarts.to_string()),
+                ("segment_secs", json_f64(p.segment_secs)),
+                ("facet_secs", json_f64(p.facet_secs)),
+                ("carve_secs", json_f64(p.carve_secs)),
+                ("facet_algorithm", json_string("cavity")),
+                ("plc", "true".into()),
+            ];
+            fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
+        }
+        let body: Vec<String> = fields
+            .iter()
+            .map(|(k, v)| format!("\"{k}\": {v}"))
+            .collect();
+        format!("{{{}}}", body.join(", "))
+    }
+}
+
+fn json_f64(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        "null".into()
+    }
+}
+
+fn json_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_escapes_and_lists_plc_figures() {
+        let s = Stats {
+            input_points: 8,
+            plc: Some(crate::constrained::PlcStats {
+                regions: 2,
+                crossing_tets: 10,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let j = s.to_json("a \"b\"\\c");
+        assert!(j.starts_with("{\"model\": \"a \\\"b\\\"\\\\c\""), "{j}");
+        assert!(j.contains("\"crossing_tets\": 10"), "{j}");
+        let rows = s.table1_rows();
+        assert!(rows.iter().any(|(k, v)| k.contains("(11)") && v == "5.0"));
+    }
+}

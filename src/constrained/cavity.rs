@@ -82,7 +82,9 @@ pub fn insert_region(
                     ..Default::default()
                 }))
             }
-            None => Ok(Outcome::NeedsSteiner(circumcenter(cdt, tris[0]))),
+            None => Ok(Outcome::NeedsSteiner(steiner_point(
+                cdt, tris, tris[0], normal,
+            ))),
         };
     }
     let crossing = cavity.len();
@@ -110,7 +112,12 @@ pub fn insert_region(
             for m in missing {
                 let Some(inner) = all[m].inner else {
                     // A triangle of R is not a face: the sides disagree on R.
-                    return Ok(Outcome::NeedsSteiner(circumcenter(cdt, all[m].verts)));
+                    return Ok(Outcome::NeedsSteiner(steiner_point(
+                        cdt,
+                        tris,
+                        all[m].verts,
+                        normal,
+                    )));
                 };
                 let outside = cdt.dt.mesh.adj(inner).tet();
                 if in_cav.contains(&outside) {
@@ -142,7 +149,7 @@ pub fn insert_region(
             if v.iter().all(|x| region.verts.contains(x)) {
                 // A shim tet: four vertices on the polygon.
                 let f = [v[0], v[1], v[2]];
-                return Ok(Outcome::NeedsSteiner(circumcenter(cdt, f)));
+                return Ok(Outcome::NeedsSteiner(steiner_point(cdt, tris, f, normal)));
             }
             new_tets.push(v);
         }
@@ -770,6 +777,46 @@ fn largest_centroid(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Point {
         .unwrap_or([0; 3]);
     let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
     std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0)
+}
+
+/// Where to put a Steiner point on the polygon for the offending face `f` (paper §3.1):
+/// its circumcenter, brought onto the polygon's plane through `f`'s centroid (so it lies
+/// no farther from the polygon than its vertices do), if that lands in one of the
+/// region's triangles; else the centroid of the region's largest triangle.
+fn steiner_point(cdt: &Cdt, tris: &[[VertexId; 3]], f: [VertexId; 3], normal: [f64; 3]) -> Point {
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
+    let centroid: Point = std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0);
+    let nn = normal.iter().map(|x| x * x).sum::<f64>();
+    let cc = circumcenter(cdt, f);
+    if nn > 0.0 && cc.iter().all(|x| x.is_finite()) {
+        let off = (0..3)
+            .map(|k| (cc[k] - centroid[k]) * normal[k])
+            .sum::<f64>()
+            / nn;
+        let q: Point = std::array::from_fn(|k| cc[k] - off * normal[k]);
+        // Inside a region triangle, seen along the normal?
+        let axis = (0..3)
+            .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+            .unwrap_or(2);
+        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+        let o2 = |x: Point, y: Point, z: Point| {
+            robust::orient2d(
+                robust::Coord { x: x[u], y: x[w] },
+                robust::Coord { x: y[u], y: y[w] },
+                robust::Coord { x: z[u], y: z[w] },
+            )
+        };
+        let inside = tris.iter().any(|t| {
+            let (x, y, z) = (p(t[0]), p(t[1]), p(t[2]));
+            let s = [o2(x, y, q), o2(y, z, q), o2(z, x, q)];
+            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+        });
+        if inside {
+            return q;
+        }
+    }
+    largest_centroid(cdt, tris)
 }
 
 /// The circumcenter of triangle `f` (an inexact construction: it only places a Steiner

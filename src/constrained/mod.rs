@@ -98,6 +98,11 @@ pub struct PlcMesh {
     pub warnings: Vec<String>,
 }
 
+/// Whether to trace restarts and Steiner points on stderr (`TETCDT_DEBUG=1`).
+fn debug() -> bool {
+    std::env::var_os("TETCDT_DEBUG").is_some()
+}
+
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 64;
 
@@ -123,28 +128,20 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     loop {
         match attempt(plc, &prep, &facet_points, &presplits, opts, &mut stats)? {
-            Attempt::Done(mut cdt, seg_markers) => {
-                let more = resolve_shims(&mut cdt, plc, opts);
-                if more.is_empty() {
-                    stats.facet_steiner_points = facet_points.len();
-                    let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats)?;
-                    return Ok(PlcMesh {
-                        mesh,
-                        stats,
-                        warnings,
-                    });
-                }
-                stats.restarts += 1;
-                if stats.restarts > MAX_RESTARTS {
-                    return Err(MeshError::Failed(
-                        "shim tets survive on polygons that are not flat".into(),
-                    )
-                    .into());
-                }
-                facet_points.extend(more);
+            Attempt::Done(cdt, seg_markers) => {
+                stats.facet_steiner_points = facet_points.len();
+                let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats)?;
+                return Ok(PlcMesh {
+                    mesh,
+                    stats,
+                    warnings,
+                });
             }
             Attempt::Restart(more, splits) => {
                 stats.restarts += 1;
+                if debug() {
+                    eprintln!("restart {}", stats.restarts);
+                }
                 if stats.restarts > MAX_RESTARTS
                     || facet_points.len() + more.len() > opts.max_steiner
                 {
@@ -342,28 +339,19 @@ fn attempt(
                     }
                 }
                 Outcome::NeedsSteiner(p) => {
+                    if debug() {
+                        eprintln!("facet {fi}: Steiner point {p:?}");
+                    }
                     steiner.push((fi, p));
                     steiner_facets.insert(fi);
                     break;
                 }
                 Outcome::SplitSubsegment(u, v) => {
+                    if debug() {
+                        eprintln!("facet {fi}: split subsegment {u}-{v}");
+                    }
                     let seg = seg_of[&edge_key(u, v)];
-                    let [a, b] = [
-                        subsegs.chains[seg][0],
-                        *subsegs.chains[seg].last().unwrap_or(&u),
-                    ];
-                    let param = |x: VertexId| {
-                        let (pa, pb, px) = (
-                            cdt.dt.points[a as usize],
-                            cdt.dt.points[b as usize],
-                            cdt.dt.points[x as usize],
-                        );
-                        let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
-                        let num: f64 = (0..3).map(|k| (px[k] - pa[k]) * d[k]).sum();
-                        let den: f64 = (0..3).map(|k| d[k] * d[k]).sum();
-                        num / den
-                    };
-                    splits.push((seg, 0.5 * (param(u) + param(v))));
+                    splits.push((seg, midpoint_parameter(&cdt, &subsegs.chains[seg], u, v)));
                     steiner_facets.insert(fi);
                     break;
                 }
@@ -371,6 +359,14 @@ fn attempt(
         }
     }
     stats.facet_secs = t2.elapsed().as_secs_f64();
+    if steiner.is_empty() && splits.is_empty() {
+        let (more, edges) = resolve_shims(&mut cdt, plc, opts);
+        steiner.extend(more);
+        for (u, v) in edges {
+            let seg = seg_of[&edge_key(u, v)];
+            splits.push((seg, midpoint_parameter(&cdt, &subsegs.chains[seg], u, v)));
+        }
+    }
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
@@ -477,17 +473,32 @@ fn inside_polygons(
         .collect()
 }
 
+/// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.
+fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -> f64 {
+    let p = |x: VertexId| cdt.dt.points[x as usize];
+    let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
+    let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+    let den: f64 = (0..3).map(|k| d[k] * d[k]).sum();
+    let t = |x: VertexId| (0..3).map(|k| (p(x)[k] - pa[k]) * d[k]).sum::<f64>() / den;
+    0.5 * (t(u) + t(v))
+}
+
 /// Removes shim tets (four vertices on one facet) from the domain. A shim that carving
 /// would keep has its two subfaces on the outer side; taking its other two faces as the
 /// polygon's triangles instead puts it outside, where carving removes it. A shim that
 /// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
 /// are returned, and the construction starts again.
-fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Point)> {
+fn resolve_shims(
+    cdt: &mut Cdt,
+    plc: &Plc,
+    opts: &PlcOptions,
+) -> (Vec<(usize, Point)>, Vec<(VertexId, VertexId)>) {
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
     for (k, &f) in &cdt.subfaces {
         facet_verts.entry(f).or_default().extend(k.iter().copied());
     }
     let mut steiner = Vec::new();
+    let mut split_edges = Vec::new();
     for _round in 0..8 {
         let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
@@ -512,6 +523,30 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
                 let i = (0..4).find(|&i| !k.contains(&v[i])).unwrap_or(0);
                 kept.contains(&cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet())
             });
+            if debug() {
+                eprintln!(
+                    "shim {v:?} facet {facet} free {} kept_behind_sub {kept_behind_sub}",
+                    free.len()
+                );
+            }
+            if opts.keep_hull && kept_behind_sub {
+                // With the hull kept, both sides of every polygon stay; a Steiner point
+                // at a subface does not help slivers outside the polygon, so leave them.
+                continue;
+            }
+            // The two subfaces' shared edge disappears with the swap: if it is a
+            // subsegment, split it instead.
+            if sub.len() == 2 && !free.is_empty() {
+                let shared: Vec<VertexId> = sub[0]
+                    .iter()
+                    .copied()
+                    .filter(|x| sub[1].contains(x))
+                    .collect();
+                if shared.len() == 2 && cdt.subsegs.contains_key(&edge_key(shared[0], shared[1])) {
+                    split_edges.push((shared[0], shared[1]));
+                    continue;
+                }
+            }
             if free.is_empty() || kept_behind_sub {
                 // Both sides of the polygon keep the shim: only a Steiner point helps.
                 let f = sub[0].map(|x| cdt.dt.points[x as usize]);
@@ -527,7 +562,7 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
             }
             swapped = true;
         }
-        if !needs.is_empty() {
+        if !needs.is_empty() || !split_edges.is_empty() {
             steiner = needs;
             break;
         }
@@ -535,7 +570,9 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
             break;
         }
     }
-    steiner
+    split_edges.sort_unstable();
+    split_edges.dedup();
+    (steiner, split_edges)
 }
 
 /// Calls `f` on every edge of the facet's rings and inner segments.

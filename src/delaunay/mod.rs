@@ -249,7 +249,12 @@ impl Delaunay {
 
     /// Is tet `t` in conflict with point `p` (vertex id `pv`)?
     fn in_conflict(&self, t: TetId, p: &Point, pv: VertexId) -> bool {
-        let v = self.mesh.verts(t);
+        self.in_conflict_with(t, self.mesh.verts(t), p, pv)
+    }
+
+    /// [`Self::in_conflict`] given the vertices `v` of tet `t`.
+    #[inline]
+    fn in_conflict_with(&self, t: TetId, v: [VertexId; 4], p: &Point, pv: VertexId) -> bool {
         if v[3] == GHOST {
             let o = self
                 .filter
@@ -263,12 +268,33 @@ impl Delaunay {
             let r = self.mesh.adj(FaceRef::new(t, 3)).tet();
             return self.in_sphere(r, p, pv);
         }
-        self.in_sphere(t, p, pv)
+        self.in_sphere_with(v, p, pv)
     }
 
     #[inline]
     fn in_sphere(&self, t: TetId, p: &Point, pv: VertexId) -> bool {
-        let v = self.mesh.verts(t);
+        self.in_sphere_with(self.mesh.verts(t), p, pv)
+    }
+
+    #[inline]
+    fn in_sphere_with(&self, v: [VertexId; 4], p: &Point, pv: VertexId) -> bool {
+        let s = self.filter.insphere(
+            self.pt(v[0]),
+            self.pt(v[1]),
+            self.pt(v[2]),
+            self.pt(v[3]),
+            p,
+        );
+        if s != 0.0 {
+            return s > 0.0;
+        }
+        self.in_sphere_tie(v, p, pv)
+    }
+
+    /// [`Self::in_sphere`] when the five points are cospherical: the perturbation decides.
+    #[cold]
+    #[inline(never)]
+    fn in_sphere_tie(&self, v: [VertexId; 4], p: &Point, pv: VertexId) -> bool {
         let pts = [
             self.pt(v[0]),
             self.pt(v[1]),
@@ -276,10 +302,6 @@ impl Delaunay {
             self.pt(v[3]),
             p,
         ];
-        let s = self.filter.insphere(pts[0], pts[1], pts[2], pts[3], pts[4]);
-        if s != 0.0 {
-            return s > 0.0;
-        }
         let ids = [v[0], v[1], v[2], v[3], pv].map(|x| self.orig[x as usize]);
         insphere_sos(pts, ids) == Sign::Positive
     }
@@ -315,6 +337,10 @@ impl Delaunay {
             k += 1;
             // One copy of the tet: its vertices and links are all read below.
             let tet = *self.mesh.tet(t);
+            // The four neighbours read up front, so that their cache misses overlap
+            // instead of each waiting behind the previous neighbour's test.
+            let nb = |f: usize| self.mesh.verts(tet.adj[f].tet());
+            let around = [nb(0), nb(1), nb(2), nb(3)];
             for (f, &outside) in tet.adj.iter().enumerate() {
                 let n = outside.tet();
                 let state = self.mark[n as usize];
@@ -322,7 +348,7 @@ impl Delaunay {
                     continue;
                 }
                 if state != OUTSIDE {
-                    if self.in_conflict(n, &p, pv) {
+                    if self.in_conflict_with(n, around[f], &p, pv) {
                         self.mark[n as usize] = IN_CONFLICT;
                         self.conflict.push(n);
                         continue;

@@ -9,10 +9,16 @@
 use super::tokens::{read_text, Line, Lines};
 use crate::error::InputError;
 use crate::plc::Plc;
+use std::fs::File;
+use std::io::Read;
 use std::path::Path;
+use std::sync::mpsc;
 
 /// Reads a `.node` file.
 pub fn read(path: &Path) -> Result<Plc, InputError> {
+    if let Some(plc) = fast::read(path) {
+        return Ok(plc);
+    }
     let text = read_text(path)?;
     parse(&text, path)
 }
@@ -128,6 +134,92 @@ pub(crate) fn read_points(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Large files take the two-thread block reader; it must read exactly what the
+    /// exact reader reads, and leave every error to it.
+    #[test]
+    fn large_files_read_the_same_both_ways() {
+        let dir = tempfile::tempdir().unwrap();
+        let exact = |path: &Path| parse(&read_text(path).unwrap(), path);
+        let two_cores = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
+        // `ok`: the file is valid; `fast`: the block reader reads it (else it gives up).
+        let mut check = |name: &str, text: String, ok: bool, fast: bool| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, &text).unwrap();
+            assert!(text.len() as u64 > fast::MIN_SIZE, "{name} is too small");
+            if two_cores {
+                assert_eq!(fast::read(&path).is_some(), fast, "{name}");
+            }
+            match (read(&path), exact(&path)) {
+                (Ok(a), Ok(b)) => {
+                    assert!(ok, "{name} should fail");
+                    assert_eq!(a.points, b.points, "{name}");
+                    assert_eq!(a.point_attrs, b.point_attrs, "{name}");
+                    assert_eq!(a.point_markers, b.point_markers, "{name}");
+                    assert_eq!(
+                        (a.first_index, a.num_point_attrs, &a.source),
+                        (b.first_index, b.num_point_attrs, &b.source)
+                    );
+                }
+                (Err(a), Err(b)) => {
+                    assert!(!ok, "{name}: {a}");
+                    assert_eq!(a.to_string(), b.to_string());
+                }
+                (a, b) => panic!("{name}: {:?} vs {:?}", a.is_ok(), b.is_ok()),
+            }
+        };
+        let n = 120_000;
+        let lines = |from: usize, extra: &dyn Fn(usize) -> String| -> String {
+            (0..n)
+                .map(|i| {
+                    let x = i as f64 / 7.0;
+                    format!("{} {x} {} -{x}e-3{}\n", i + from, i % 97, extra(i))
+                })
+                .collect()
+        };
+        check(
+            "plain.node",
+            format!("{n} 3 0 0\n{}", lines(1, &|_| String::new())),
+            true,
+            true,
+        );
+        check(
+            "attrs.node",
+            format!(
+                "# c\n\n{n}  3  2  1\n{}",
+                lines(0, &|i| format!(" {i}.5 -2 {} # x", i % 5))
+            ),
+            true,
+            true,
+        );
+        let crlf = lines(1, &|_| String::new()).replace('\n', "\r\n");
+        check(
+            "crlf.node",
+            format!("{n} 3 0 0\r\n{crlf}# trailing\n"),
+            true,
+            true,
+        );
+        let mut more = lines(1, &|_| String::new());
+        more.push_str("junk that the reader ignores\n");
+        check("trailing.node", format!("{n} 3 0 0\n{more}"), true, false);
+        check(
+            "short.node",
+            format!("{} 3 0 0\n{}", n + 1, lines(1, &|_| String::new())),
+            false,
+            false,
+        );
+        let mut bad = lines(1, &|_| String::new());
+        bad.replace_range(3_000_000..3_000_001, "x");
+        check("bad.node", format!("{n} 3 0 0\n{bad}"), false, false);
+        let skip = lines(1, &|_| String::new()).replacen("\n5000 ", "\n5001 ", 1);
+        check("skip.node", format!("{n} 3 0 0\n{skip}"), false, false);
+        check(
+            "from2.node",
+            format!("{n} 3 0 0\n{}", lines(2, &|_| String::new())),
+            false,
+            false,
+        );
+    }
 
     fn parse_ok(text: &str) -> Plc {
         parse(text, Path::new("t.node")).unwrap()
@@ -286,5 +378,219 @@ mod tests {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/examples/points8.node");
         let plc = read(&path).unwrap();
         assert_eq!(plc.points.len(), 8);
+    }
+}
+
+/// The reader of large, well-formed `.node` files: the file is read a block of lines at
+/// a time into reused buffers, and two threads parse alternate blocks.
+///
+/// A million points are 70 MB of text: reading them whole into fresh memory cost as
+/// much as parsing them, and parsing is easily split. Anything unusual (an error, a
+/// stray line, a file that is not UTF-8) makes it give up, and the exact reader then
+/// reads the file and reports the problem.
+mod fast {
+    use super::*;
+
+    /// Files smaller than this are left to the exact reader.
+    pub(super) const MIN_SIZE: u64 = 1 << 22;
+    /// Bytes per block (a block ends at a line end, so it may be longer).
+    const BLOCK: usize = 1 << 20;
+
+    /// The points parsed from one block.
+    #[derive(Default)]
+    struct Points {
+        xyz: Vec<[f64; 3]>,
+        attrs: Vec<f64>,
+        markers: Vec<i32>,
+        /// The number written on the block's first point line.
+        first_number: i64,
+    }
+
+    /// The layout of the point lines, from the header.
+    #[derive(Clone, Copy)]
+    struct Layout {
+        attrs: usize,
+        markers: bool,
+    }
+
+    /// Parses every line of `text` as a point line with consecutive numbers into `out`;
+    /// false if any line does not fit.
+    fn parse_block(text: &[u8], layout: Layout, out: &mut Points) -> bool {
+        let Ok(text) = std::str::from_utf8(text) else {
+            return false;
+        };
+        out.xyz.clear();
+        out.attrs.clear();
+        out.markers.clear();
+        let mut lines = Lines::new(text, Path::new(""));
+        while let Some(mut line) = lines.next_line() {
+            let Ok(number) = line.int(String::new) else {
+                return false;
+            };
+            if out.xyz.is_empty() {
+                out.first_number = number;
+            } else if number != out.first_number + out.xyz.len() as i64 {
+                return false;
+            }
+            let Ok(p) = line.xyz(&String::new) else {
+                return false;
+            };
+            out.xyz.push(p);
+            for _ in 0..layout.attrs {
+                let Ok(a) = line.float(String::new) else {
+                    return false;
+                };
+                out.attrs.push(a);
+            }
+            if layout.markers {
+                let Ok(m) = line.marker(String::new) else {
+                    return false;
+                };
+                out.markers.push(m);
+            }
+        }
+        true
+    }
+
+    /// Reads the next block of whole lines into `buf`, keeping a partial last line in
+    /// `carry` for the next block; an empty block means the end of the file. Fails on a
+    /// line longer than a block.
+    fn next_block(file: &mut File, carry: &mut Vec<u8>, buf: &mut Vec<u8>) -> std::io::Result<()> {
+        buf.clear();
+        buf.append(carry);
+        while buf.len() < BLOCK {
+            let start = buf.len();
+            buf.resize(start + BLOCK, 0);
+            let n = file.read(&mut buf[start..])?;
+            buf.truncate(start + n);
+            if n == 0 {
+                return Ok(());
+            }
+        }
+        match buf.iter().rposition(|&b| b == b'\n') {
+            Some(end) => {
+                carry.extend_from_slice(&buf[end + 1..]);
+                buf.truncate(end + 1);
+                Ok(())
+            }
+            // A line longer than a block: not worth handling here.
+            None => Err(std::io::Error::other("line too long")),
+        }
+    }
+
+    /// The points of a large `.node` file, or `None` to leave it to the exact reader.
+    pub(super) fn read(path: &Path) -> Option<Plc> {
+        let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(2));
+        let mut file = File::open(path).ok()?;
+        let size = file.metadata().ok()?.len();
+        if size < MIN_SIZE || workers < 2 {
+            return None;
+        }
+        let mut carry = Vec::new();
+        let mut first = Vec::new();
+        next_block(&mut file, &mut carry, &mut first).ok()?;
+        let text = std::str::from_utf8(&first).ok()?;
+        let mut lines = Lines::new(text, path);
+        let mut header = lines.next_line()?;
+        let count = header.count(String::new).ok()?;
+        let dim = header.opt_count(String::new).ok()?.unwrap_or(3);
+        let attrs = header.opt_count(String::new).ok()?.unwrap_or(0);
+        let markers = header.opt_flag(String::new).ok()?;
+        if dim != 3 || u32::try_from(count).is_err() {
+            return None;
+        }
+        let layout = Layout { attrs, markers };
+        // The lines after the header are the first block of points.
+        let skip = text.len() - lines.remaining().len();
+        first.drain(..skip);
+
+        // Bounded by the file size, as the exact reader bounds it by the text.
+        let cap = count.min((size / 8) as usize + 1);
+        let mut plc = Plc {
+            source: path.to_path_buf(),
+            points: Vec::with_capacity(cap),
+            num_point_attrs: attrs,
+            point_attrs: Vec::with_capacity(cap.saturating_mul(attrs).min(size as usize / 2)),
+            point_markers: markers.then(|| Vec::with_capacity(cap)),
+            ..Default::default()
+        };
+        let ok = std::thread::scope(|scope| {
+            // Per worker: blocks to parse in, parsed blocks (with their buffers) out.
+            let mut lanes = Vec::with_capacity(workers);
+            for _ in 0..workers {
+                let (todo_tx, todo_rx) = mpsc::sync_channel::<(Vec<u8>, Points)>(1);
+                let (done_tx, done_rx) = mpsc::sync_channel::<(Vec<u8>, Points, bool)>(1);
+                scope.spawn(move || {
+                    for (text, mut pts) in todo_rx {
+                        let ok = parse_block(&text, layout, &mut pts);
+                        if done_tx.send((text, pts, ok)).is_err() {
+                            return;
+                        }
+                    }
+                });
+                lanes.push((todo_tx, done_rx));
+            }
+            // Keeps every worker one block ahead of the merge.
+            let mut spare: Vec<(Vec<u8>, Points)> = Vec::new();
+            let mut next = Some(first);
+            let (mut sent, mut merged) = (0usize, 0usize);
+            loop {
+                while sent < merged + workers {
+                    let Some(block) = next.take() else { break };
+                    let pts = spare.pop().map(|(_, p)| p).unwrap_or_default();
+                    if lanes[sent % workers].0.send((block, pts)).is_err() {
+                        return false;
+                    }
+                    sent += 1;
+                    let mut buf = spare.pop().map(|(b, _)| b).unwrap_or_default();
+                    if next_block(&mut file, &mut carry, &mut buf).is_err() {
+                        return false;
+                    }
+                    next = (!buf.is_empty()).then_some(buf);
+                }
+                if merged == sent {
+                    return true;
+                }
+                let Ok((text, pts, ok)) = lanes[merged % workers].1.recv() else {
+                    return false;
+                };
+                merged += 1;
+                if !ok || !merge(&mut plc, &pts, count) {
+                    return false;
+                }
+                spare.push((text, pts));
+            }
+        });
+        (ok && plc.points.len() == count).then_some(plc)
+    }
+
+    /// Appends a parsed block to `plc`, checking its numbering against the points before
+    /// it; points beyond `count` are left out, as the exact reader ignores those lines.
+    fn merge(plc: &mut Plc, pts: &Points, count: usize) -> bool {
+        let have = plc.points.len();
+        if pts.xyz.is_empty() || have == count {
+            return true;
+        }
+        let first = if have == 0 {
+            match pts.first_number {
+                0 => 0,
+                1 => 1,
+                _ => return false,
+            }
+        } else {
+            plc.first_index
+        };
+        if pts.first_number != (first + have) as i64 {
+            return false;
+        }
+        plc.first_index = first;
+        let take = pts.xyz.len().min(count - have);
+        plc.points.extend_from_slice(&pts.xyz[..take]);
+        plc.point_attrs
+            .extend_from_slice(&pts.attrs[..take * plc.num_point_attrs]);
+        if let Some(m) = plc.point_markers.as_mut() {
+            m.extend_from_slice(&pts.markers[..take]);
+        }
+        true
     }
 }

@@ -33,6 +33,7 @@
 use crate::error::Error;
 use crate::options::Options;
 use crate::output::MeshOut;
+use crate::plc::Plc;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::cell::OnceCell;
 use std::ffi::{OsStr, OsString};
@@ -251,6 +252,19 @@ pub fn write_files(
     w: &WriteOptions,
     on_file: &mut dyn FnMut(&Path),
 ) -> Result<Vec<PathBuf>, Error> {
+    write_files_with(mesh, prefix, w, on_file, None)
+}
+
+/// [`write_files`], taking the `.node` file from `early` (see [`write_node_early`]) if
+/// it holds the mesh's nodes.
+pub fn write_files_with(
+    mesh: &MeshOut,
+    prefix: &Path,
+    w: &WriteOptions,
+    on_file: &mut dyn FnMut(&Path),
+    early: Option<EarlyNode>,
+) -> Result<Vec<PathBuf>, Error> {
+    let mut early = early.filter(|e| e.digest == Nodes::of_mesh(mesh).digest());
     let kinds = file_kinds(mesh.plc_mode, w);
     let finals: Vec<PathBuf> = kinds.iter().map(|&k| output_path(prefix, k)).collect();
     let mut temps: Vec<PathBuf> = Vec::with_capacity(kinds.len());
@@ -263,6 +277,13 @@ pub fn write_files(
             on_file(fin);
             let tmp = temp_path(fin);
             temps.push(tmp.clone());
+            if kind == FileKind::Node {
+                if let Some(e) = early.as_mut() {
+                    // From here on the temporary is ours to rename or remove.
+                    e.kept = true;
+                    continue;
+                }
+            }
             let out_err = |source| Error::Output {
                 file: fin.clone(),
                 source,
@@ -364,19 +385,74 @@ fn write_kind_with<'a, W: Write>(
 
 /// Writes the `.node` file.
 pub fn write_node<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io::Result<()> {
-    let base = w.base(mesh.first_index);
-    let na = mesh.num_point_attrs;
-    let mut b = LineBuf::new(out);
-    b.int(mesh.points.len() as i64, 0);
+    write_nodes(&mut LineBuf::new(out), &Nodes::of_mesh(mesh), w)
+}
+
+/// What a `.node` file holds: the nodes with their attributes and markers.
+#[derive(Clone, Copy)]
+pub struct Nodes<'a> {
+    points: &'a [[f64; 3]],
+    num_attrs: usize,
+    attrs: &'a [f64],
+    markers: Option<&'a [i32]>,
+    first_index: usize,
+}
+
+impl<'a> Nodes<'a> {
+    /// The nodes of a finished mesh.
+    pub fn of_mesh(mesh: &'a MeshOut) -> Self {
+        Nodes {
+            points: &mesh.points,
+            num_attrs: mesh.num_point_attrs,
+            attrs: &mesh.point_attrs,
+            markers: mesh.point_markers.as_deref(),
+            first_index: mesh.first_index,
+        }
+    }
+
+    /// The points of a model, which are the nodes of the mesh of a point set.
+    pub fn of_plc(plc: &'a Plc) -> Self {
+        Nodes {
+            points: &plc.points,
+            num_attrs: plc.num_point_attrs,
+            attrs: &plc.point_attrs,
+            markers: plc.point_markers.as_deref(),
+            first_index: plc.first_index,
+        }
+    }
+
+    /// A hash of everything written, to recognise a `.node` file written early.
+    fn digest(&self) -> u64 {
+        let mut h = (self.points.len() as u64) ^ (self.num_attrs as u64) << 40;
+        h ^= (self.first_index as u64) << 50 ^ u64::from(self.markers.is_some()) << 60;
+        let mut mix = |x: u64| h = (h ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(29);
+        self.points.iter().flatten().for_each(|x| mix(x.to_bits()));
+        self.attrs.iter().for_each(|x| mix(x.to_bits()));
+        self.markers
+            .into_iter()
+            .flatten()
+            .for_each(|&m| mix(m as u64));
+        h
+    }
+}
+
+fn write_nodes<W: Write>(
+    b: &mut LineBuf<'_, W>,
+    nodes: &Nodes<'_>,
+    w: &WriteOptions,
+) -> io::Result<()> {
+    let base = w.base(nodes.first_index);
+    let na = nodes.num_attrs;
+    b.int(nodes.points.len() as i64, 0);
     b.str("  3  ");
     b.int(na as i64, 0);
     b.str("  ");
-    b.int(i64::from(mesh.point_markers.is_some()), 0);
+    b.int(i64::from(nodes.markers.is_some()), 0);
     b.nl()?;
-    b.records(mesh.points.len(), |t, i| {
+    b.records(nodes.points.len(), |t, i| {
         t.int(base + i as i64, 4);
         t.str("   ");
-        for &x in &mesh.points[i] {
+        for &x in &nodes.points[i] {
             t.str(" ");
             t.float(x);
             t.str(" ");
@@ -384,16 +460,60 @@ pub fn write_node<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io
         t.trim_one_space();
         for k in 0..na {
             t.str("  ");
-            t.float(mesh.point_attrs.get(i * na + k).copied().unwrap_or(0.0));
+            t.float(nodes.attrs.get(i * na + k).copied().unwrap_or(0.0));
         }
-        if let Some(m) = &mesh.point_markers {
+        if let Some(m) = nodes.markers {
             t.str("    ");
             t.int(i64::from(m.get(i).copied().unwrap_or(0)), 0);
         }
         t.end_line();
     })?;
     b.comment(w)?;
-    b.finish()
+    b.flush()
+}
+
+/// A `.node` file written ahead of the others by [`write_node_early`]: a temporary file
+/// that [`write_files_with`] renames into place with the rest, or that is removed when
+/// this is dropped unused.
+pub struct EarlyNode {
+    tmp: PathBuf,
+    digest: u64,
+    kept: bool,
+}
+
+impl Drop for EarlyNode {
+    fn drop(&mut self) {
+        if !self.kept {
+            let _ = fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes the `.node` file of `nodes` under `prefix` to its temporary name, on this
+/// thread alone. The nodes of a point set's mesh are its input points, so their file
+/// can be written on a spare core while the points are meshed; [`write_files_with`]
+/// then uses it if the mesh's nodes are the same.
+pub fn write_node_early(
+    nodes: &Nodes<'_>,
+    prefix: &Path,
+    w: &WriteOptions,
+) -> Result<EarlyNode, Error> {
+    let fin = output_path(prefix, FileKind::Node);
+    let early = EarlyNode {
+        tmp: temp_path(&fin),
+        digest: nodes.digest(),
+        kept: false,
+    };
+    let out_err = |source| Error::Output {
+        file: fin.clone(),
+        source,
+    };
+    let mut file = File::create(&early.tmp).map_err(out_err)?;
+    let mut b = LineBuf::new(&mut file);
+    // One thread: the meshing runs on the other core.
+    b.workers = 1;
+    write_nodes(&mut b, nodes, w).map_err(out_err)?;
+    Ok(early)
 }
 
 /// Writes the `.ele` file.
@@ -817,6 +937,21 @@ fn sorted2(e: [u32; 2]) -> [u32; 2] {
     }
 }
 
+/// The eight decimal digits of `u` (below 10^8), most significant first, as the bytes
+/// 0..=9 of a little-endian `u64`: the quotients by 10^4, 10^2 and 10 of all lanes are
+/// taken at once with multiply-shifts that are exact in these ranges.
+fn eight_digits(u: u32) -> u64 {
+    debug_assert!(u < 100_000_000);
+    // Two 4-digit halves in 32-bit lanes, the high half first in memory.
+    let x = u64::from(u / 10_000) | (u64::from(u % 10_000) << 32);
+    // Each lane split into two 2-digit 16-bit lanes (x / 100 = x * 5243 >> 19 for x < 10^4).
+    let q = ((x * 5243) >> 19) & 0x0000_007f_0000_007f;
+    let x = q | ((x - q * 100) << 16);
+    // Each 16-bit lane split into two digits (x / 10 = x * 103 >> 10 for x < 100).
+    let q = ((x * 103) >> 10) & 0x000f_000f_000f_000f;
+    q | ((x - q * 10) << 8)
+}
+
 /// Text being formatted: a byte buffer and the float formatter's scratch.
 struct Text {
     buf: Vec<u8>,
@@ -847,7 +982,36 @@ impl Text {
     }
 
     /// Appends `v` right-aligned in `width` columns (like `%<width>d`).
+    ///
+    /// A big mesh has tens of millions of numbers, and formatting them was most of the
+    /// cost of writing it; so numbers below 10^8 in at most 8 columns (all node and
+    /// tet numbers of a mesh that fits in memory) take a branch-free path: all eight
+    /// digits at once in the lanes of a `u64`, leading zeros turned into spaces, and
+    /// one fixed-size copy.
+    #[inline]
     fn int(&mut self, v: i64, width: usize) {
+        match u32::try_from(v) {
+            Ok(u) if u < 100_000_000 && width <= 8 => self.small_uint(u, width),
+            _ => self.any_int(v, width),
+        }
+    }
+
+    fn small_uint(&mut self, u: u32, width: usize) {
+        let x = eight_digits(u);
+        // Leading zero digits are the low zero bytes (the first in memory); 0 has one digit.
+        let digits = 8 - (x.trailing_zeros() as usize / 8).min(7);
+        let n = digits.max(width);
+        // The last n characters, moved to the front, with the leading zeros as spaces.
+        let text = (x | 0x3030_3030_3030_3030) >> ((8 - n) * 8);
+        let pad = (1u64 << ((n - digits) * 8)) - 1;
+        let text = (text & !pad) | (0x2020_2020_2020_2020 & pad);
+        let len = self.buf.len();
+        self.buf.extend_from_slice(&text.to_le_bytes());
+        self.buf.truncate(len + n);
+    }
+
+    /// [`Self::int`] for any value and width.
+    fn any_int(&mut self, v: i64, width: usize) {
         let mut tmp = [0u8; 20];
         let mut pos = tmp.len();
         let mut u = v.unsigned_abs();
@@ -890,6 +1054,8 @@ impl Text {
 struct LineBuf<'w, W: Write> {
     out: &'w mut W,
     text: Text,
+    /// Threads formatting large record lists (see [`LineBuf::records`]).
+    workers: usize,
 }
 
 impl<W: Write> std::ops::Deref for LineBuf<'_, W> {
@@ -913,6 +1079,7 @@ impl<'w, W: Write> LineBuf<'w, W> {
         LineBuf {
             out,
             text: Text::new(),
+            workers: std::thread::available_parallelism().map_or(1, |n| n.get().min(2)),
         }
     }
 
@@ -932,8 +1099,7 @@ impl<'w, W: Write> LineBuf<'w, W> {
     /// formatted by two threads in alternating blocks while this one writes the blocks
     /// in order; the bytes are the same as formatting them one by one.
     fn records(&mut self, count: usize, line: impl Fn(&mut Text, usize) + Sync) -> io::Result<()> {
-        let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(2));
-        self.records_on(workers, count, line)
+        self.records_on(self.workers, count, line)
     }
 
     /// [`Self::records`] with `workers` formatting threads (one means this thread alone).
@@ -1012,6 +1178,10 @@ impl<'w, W: Write> LineBuf<'w, W> {
     }
 
     fn finish(mut self) -> io::Result<()> {
+        self.flush()
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
         self.out.write_all(&self.text.buf)?;
         self.text.buf.clear();
         self.out.flush()
@@ -1269,6 +1439,44 @@ mod tests {
         };
         assert!(render(FileKind::Neigh, &m, &w).contains("   1      -1    -1    -1     2\n"));
         assert!(render(FileKind::Face, &m, &w).starts_with("6  0\n"));
+    }
+
+    #[test]
+    fn integers_are_formatted_like_printf() {
+        let cases: [(i64, usize); 20] = [
+            (99_999_999, 8),
+            (100_000_000, 5),
+            (12_345_678, 9),
+            (4_294_967_295, 5),
+            (1, 8),
+            (10_000, 0),
+            (0, 0),
+            (7, 4),
+            (10, 1),
+            (99, 5),
+            (100, 2),
+            (12345, 5),
+            (123456, 5),
+            (-1, 4),
+            (-10, 0),
+            (-99999, 6),
+            (1_000_000_007, 3),
+            (i64::MAX, 0),
+            (i64::MIN, 25),
+            (-1234567, 12),
+        ];
+        let more =
+            (0..200_000i64).map(|i| ((i * 2_654_435_761) % 1_000_000_007, (i % 10) as usize));
+        for (v, w) in cases.into_iter().chain(more) {
+            let mut t = Text::new();
+            t.str("|");
+            t.int(v, w);
+            assert_eq!(
+                String::from_utf8(t.buf).unwrap(),
+                format!("|{v:>w$}"),
+                "{v} {w}"
+            );
+        }
     }
 
     /// Records formatted by worker threads come out exactly as formatted in order.
