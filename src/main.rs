@@ -57,6 +57,9 @@ struct Cli {
     /// Validate the mesh after writing it; exit 1 listing the problems if any.
     #[arg(long)]
     check: bool,
+    /// Write the run's statistics (with -p, the paper's Table 1 figures) as JSON to FILE.
+    #[arg(long = "stats-json", value_name = "FILE")]
+    stats_json: Option<PathBuf>,
     /// Print the version.
     #[arg(long, action = ArgAction::Version)]
     version: Option<bool>,
@@ -169,6 +172,7 @@ fn parse_args(args: &[OsString]) -> Result<Option<(Options, PathBuf)>, Failure> 
         .map_err(|e| Failure::new(EXIT_USAGE, anyhow!("{e} (see tetcdt --help)")))?;
     opts.output = cli.output;
     opts.check = cli.check;
+    opts.stats_json = cli.stats_json;
     Ok(Some((opts, cli.file)))
 }
 
@@ -258,6 +262,23 @@ fn run(args: Vec<OsString>) -> Result<i32, Failure> {
         say!(say, "  Sorting seconds: {}", s.sort_secs);
         say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
         say!(say, "  Meshing seconds: {}", s.total_secs);
+        let rows = s.table1_rows();
+        if !rows.is_empty() {
+            say!(say, "");
+            say!(
+                say,
+                "  Constrained Delaunay (rows of Si & Shewchuk's Table 1):"
+            );
+            for (label, value) in rows {
+                say!(say, "    {label:<45} {value}");
+            }
+        }
+    }
+    if let Some(path) = &opts.stats_json {
+        let json = meshed.stats.to_json(&file.to_string_lossy());
+        std::fs::write(path, json + "\n").map_err(|e| {
+            Failure::new(tetcdt::error::EXIT_IO, anyhow!("{}: {e}", path.display()))
+        })?;
     }
 
     if opts.check {

@@ -55,6 +55,8 @@ pub struct Options {
     pub output: Option<PathBuf>,
     /// `--check`: validate the mesh after writing it.
     pub check: bool,
+    /// `--stats-json FILE`: write the run's statistics as JSON.
+    pub stats_json: Option<PathBuf>,
     /// `-M`: do not merge edge-adjacent coplanar facets; needs `-p`.
     pub no_merge: bool,
     /// `-c`: keep the convex hull instead of carving the exterior; needs `-p`.

@@ -69,7 +69,10 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
         merge: !opts.no_merge,
         keep_hull: opts.keep_hull,
         region_attributes: opts.region_attributes,
-        max_steiner: opts.max_steiner.unwrap_or(usize::MAX),
+        // Without -S, a generous bound still guarantees that every run ends.
+        max_steiner: opts
+            .max_steiner
+            .unwrap_or((20 * plc.points.len()).max(1_000_000)),
     };
     let done = crate::constrained::mesh_plc(plc, &popts)?;
     let ps = done.stats;

@@ -742,3 +742,21 @@ fn writer_formats_on_two_tets() {
         ]
     );
 }
+
+#[test]
+fn stats_json_matches_the_written_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let src =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/examples/box_with_hole.poly");
+    fs::copy(&src, dir.path().join("b.poly")).unwrap();
+    let (code, _, stderr) = run_in(dir.path(), &["-pQ", "--stats-json", "s.json", "b.poly"]);
+    assert_eq!(code, 0, "{stderr}");
+    let json = fs::read_to_string(dir.path().join("s.json")).unwrap();
+    let ele = fs::read_to_string(dir.path().join("b.1.ele")).unwrap();
+    let tets: usize = ele.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(json.contains(&format!("\"output_tets\": {tets}")), "{json}");
+    assert!(
+        json.contains("\"plc\": true") && json.contains("\"crossing_tets\""),
+        "{json}"
+    );
+}

@@ -98,17 +98,26 @@ pub struct PlcMesh {
     pub warnings: Vec<String>,
 }
 
+/// An edge as a pair of vertex ids.
+type Edge = (VertexId, VertexId);
+
 /// Whether to trace restarts and Steiner points on stderr (`TETCDT_DEBUG=1`).
 fn debug() -> bool {
     std::env::var_os("TETCDT_DEBUG").is_some()
 }
 
+/// Marks the failure to triangulate a merged group in one plane (then split).
+const UNFLAT_GROUP: &str = "merged facets ";
+
 /// The most restarts for Steiner points on polygons before giving up.
-const MAX_RESTARTS: usize = 64;
+const MAX_RESTARTS: usize = 24;
 
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
-    let prep = prepare(plc, opts.merge)?;
+    let mut prep = prepare(plc, opts.merge)?;
+    // Input facets kept out of merging because their merged group could not be
+    // triangulated in one plane.
+    let mut keep_apart: Vec<usize> = Vec::new();
     let mut warnings = Vec::new();
     for &(dup, kept) in &prep.duplicates {
         warnings.push(format!(
@@ -127,7 +136,30 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     let mut facet_points: Vec<(usize, Point)> = Vec::new();
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     loop {
-        match attempt(plc, &prep, &facet_points, &presplits, opts, &mut stats)? {
+        let outcome = match attempt(plc, &prep, &facet_points, &presplits, opts, &mut stats) {
+            Err(Error::Mesh(MeshError::Failed(msg))) if msg.starts_with(UNFLAT_GROUP) => {
+                // Which group failed is in the message; split it and start again.
+                let sources: Vec<usize> = msg[UNFLAT_GROUP.len()..]
+                    .split(':')
+                    .next()
+                    .unwrap_or("")
+                    .split(',')
+                    .filter_map(|s| s.trim().parse().ok())
+                    .collect();
+                if sources.is_empty() || sources.iter().all(|s| keep_apart.contains(s)) {
+                    return Err(MeshError::Failed(msg[UNFLAT_GROUP.len()..].to_string()).into());
+                }
+                keep_apart.extend(sources);
+                keep_apart.sort_unstable();
+                keep_apart.dedup();
+                prep = prepare::prepare_except(plc, opts.merge, &keep_apart)?;
+                facet_points.clear();
+                presplits.clear();
+                continue;
+            }
+            r => r?,
+        };
+        match outcome {
             Attempt::Done(cdt, seg_markers) => {
                 stats.facet_steiner_points = facet_points.len();
                 let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats)?;
@@ -299,7 +331,29 @@ fn attempt(
             &f.holes,
             f.normal,
         )
-        .map_err(|e| MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f))))?;
+        .map_err(|e| {
+            if debug() {
+                eprintln!(
+                    "facet {fi}: sources {:?} rings {:?}",
+                    f.source_facets, f.rings
+                );
+                let o: Vec<(u32, u32)> = constraints
+                    .iter()
+                    .map(|c| (cdt.dt.orig[c[0] as usize], cdt.dt.orig[c[1] as usize]))
+                    .collect();
+                eprintln!("  constraints (output ids) {o:?}");
+            }
+            if f.source_facets.len() > 1 {
+                let list: Vec<String> = f.source_facets.iter().map(|s| s.to_string()).collect();
+                MeshError::Failed(format!(
+                    "{UNFLAT_GROUP}{}: facet {}: {e}",
+                    list.join(","),
+                    facet_name(plc, f)
+                ))
+            } else {
+                MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f)))
+            }
+        })?;
         // A merged facet covers only its polygons: keep the triangles reachable from the
         // inner side of its polygons' edges without crossing a subsegment (gaps that the
         // polygons enclose without covering are not reachable from the hull's flood).
@@ -488,11 +542,7 @@ fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -
 /// polygon's triangles instead puts it outside, where carving removes it. A shim that
 /// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
 /// are returned, and the construction starts again.
-fn resolve_shims(
-    cdt: &mut Cdt,
-    plc: &Plc,
-    opts: &PlcOptions,
-) -> (Vec<(usize, Point)>, Vec<(VertexId, VertexId)>) {
+fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Point)>, Vec<Edge>) {
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
     for (k, &f) in &cdt.subfaces {
         facet_verts.entry(f).or_default().extend(k.iter().copied());

@@ -136,6 +136,17 @@ impl Dsu {
 
 /// Prepares a PLC for meshing: duplicate points, cleaned polygons, merged facets, segments.
 pub fn prepare(plc: &Plc, merge: bool) -> Result<PreparedPlc, PrepError> {
+    prepare_except(plc, merge, &[])
+}
+
+/// Like [`prepare`], but the input facets listed in `keep_apart` (sorted) are never merged
+/// with their neighbours: the fallback for a merged group that is too far from flat to be
+/// triangulated in one plane.
+pub fn prepare_except(
+    plc: &Plc,
+    merge: bool,
+    keep_apart: &[usize],
+) -> Result<PreparedPlc, PrepError> {
     let pts = &plc.points;
     let n = pts.len();
     let invalid = |msg: String| InputError::Invalid {
@@ -251,6 +262,10 @@ pub fn prepare(plc: &Plc, merge: bool) -> Result<PreparedPlc, PrepError> {
                 continue;
             }
             let (a, b) = (us[0] as usize, us[1] as usize);
+            let apart = |i: usize| keep_apart.binary_search(&polys[i].facet).is_ok();
+            if apart(a) || apart(b) {
+                continue;
+            }
             if let (Some(n1), Some(n2)) = (unit[a], unit[b]) {
                 let d = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2];
                 if d.abs() >= cos_tol {

@@ -30,12 +30,17 @@ pub fn hilbert_keys<const L: usize>(cells: [[u32; 3]; L]) -> [u64; L] {
     // bits of x[0] (the level's bit is set in x[i]) or exchange them with those of x[i].
     for level in (1..BITS).rev() {
         let p = (1u32 << level) - 1;
-        for i in 0..3 {
-            for l in 0..L {
-                let set = 0u32.wrapping_sub((x[i][l] >> level) & 1);
-                let t = (x[0][l] ^ x[i][l]) & p & !set;
-                x[0][l] ^= (p & set) ^ t;
-                x[i][l] ^= t;
+        let [x0, x1, x2] = &mut x;
+        // For x[0] itself the exchange is a no-op, leaving only the inversion.
+        for u in x0.iter_mut() {
+            *u ^= p & 0u32.wrapping_sub((*u >> level) & 1);
+        }
+        for xi in [x1, x2] {
+            for (u, w) in x0.iter_mut().zip(xi.iter_mut()) {
+                let set = 0u32.wrapping_sub((*w >> level) & 1);
+                let t = (*u ^ *w) & p & !set;
+                *u ^= (p & set) ^ t;
+                *w ^= t;
             }
         }
     }

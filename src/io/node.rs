@@ -143,7 +143,7 @@ mod tests {
         let exact = |path: &Path| parse(&read_text(path).unwrap(), path);
         let two_cores = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
         // `ok`: the file is valid; `fast`: the block reader reads it (else it gives up).
-        let mut check = |name: &str, text: String, ok: bool, fast: bool| {
+        let check = |name: &str, text: String, ok: bool, fast: bool| {
             let path = dir.path().join(name);
             std::fs::write(&path, &text).unwrap();
             assert!(text.len() as u64 > fast::MIN_SIZE, "{name} is too small");

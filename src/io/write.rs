@@ -288,6 +288,13 @@ pub fn write_files_with(
                 file: fin.clone(),
                 source,
             };
+            if matches!(kind, FileKind::Node | FileKind::Ele) {
+                // The big ones.
+                let mut file = OutFile::create(&tmp).map_err(out_err)?;
+                write_kind_with(&mut file, kind, mesh, w, &derived).map_err(out_err)?;
+                file.finish().map_err(out_err)?;
+                continue;
+            }
             let file = File::create(&tmp).map_err(out_err)?;
             let mut bw = BufWriter::with_capacity(1 << 16, file);
             write_kind_with(&mut bw, kind, mesh, w, &derived).map_err(out_err)?;
@@ -508,12 +515,195 @@ pub fn write_node_early(
         file: fin.clone(),
         source,
     };
-    let mut file = File::create(&early.tmp).map_err(out_err)?;
+    let mut file = OutFile::create(&early.tmp).map_err(out_err)?;
     let mut b = LineBuf::new(&mut file);
     // One thread: the meshing runs on the other core.
     b.workers = 1;
     write_nodes(&mut b, nodes, w).map_err(out_err)?;
+    file.finish().map_err(out_err)?;
     Ok(early)
+}
+
+/// The output file type: direct I/O where available (see [`DirectFile`]).
+#[cfg(unix)]
+type OutFile = DirectFile;
+#[cfg(not(unix))]
+type OutFile = PlainFile;
+
+/// A buffered file with [`DirectFile`]'s interface.
+#[cfg(not(unix))]
+struct PlainFile(BufWriter<File>);
+
+#[cfg(not(unix))]
+impl PlainFile {
+    fn create(path: &Path) -> io::Result<Self> {
+        Ok(PlainFile(BufWriter::with_capacity(
+            1 << 16,
+            File::create(path)?,
+        )))
+    }
+
+    fn finish(mut self) -> io::Result<()> {
+        self.0.flush()
+    }
+}
+
+#[cfg(not(unix))]
+impl Write for PlainFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush()
+    }
+}
+
+/// `O_DIRECT`, where we know its value.
+#[cfg(all(target_os = "linux", any(target_arch = "x86_64", target_arch = "x86")))]
+const O_DIRECT: Option<i32> = Some(0o40000);
+#[cfg(all(target_os = "linux", any(target_arch = "aarch64", target_arch = "arm")))]
+const O_DIRECT: Option<i32> = Some(0o200000);
+#[cfg(not(all(
+    target_os = "linux",
+    any(
+        target_arch = "x86_64",
+        target_arch = "x86",
+        target_arch = "aarch64",
+        target_arch = "arm"
+    )
+)))]
+const O_DIRECT: Option<i32> = None;
+
+/// Alignment of direct writes (addresses, offsets and lengths): the largest logical
+/// block size in use.
+const DIRECT_ALIGN: usize = 4096;
+/// Bytes per direct write.
+const DIRECT_CHUNK: usize = 4 << 20;
+/// Direct writes slower than this (bytes per second) go back to the page cache.
+const DIRECT_MIN_RATE: f64 = 1e9;
+
+/// A big output file, written with direct I/O (bypassing the page cache) where the file
+/// system supports it and the disk keeps up.
+///
+/// Copying hundreds of megabytes into freshly allocated page-cache pages can cost
+/// several times more than the disk write itself (on the virtual machines this was
+/// tuned on, 2.5 ms per megabyte against 0.3 ms); direct writes skip the copy. Data
+/// are staged in an aligned buffer and written in aligned chunks; the unaligned tail,
+/// and everything after a direct write fails or runs slow, takes the ordinary path.
+#[cfg(unix)]
+struct DirectFile {
+    plain: File,
+    direct: Option<File>,
+    stage: Vec<u8>,
+    /// Where the aligned window starts in `stage`.
+    start: usize,
+    /// Bytes staged in the window.
+    len: usize,
+    /// Bytes in the file so far.
+    written: u64,
+}
+
+#[cfg(unix)]
+impl DirectFile {
+    fn create(path: &Path) -> io::Result<Self> {
+        use std::os::unix::fs::OpenOptionsExt;
+        let plain = File::create(path)?;
+        let direct = O_DIRECT.and_then(|flag| {
+            fs::OpenOptions::new()
+                .write(true)
+                .custom_flags(flag)
+                .open(path)
+                .ok()
+        });
+        let (stage, start) = if direct.is_some() {
+            let stage = vec![0u8; DIRECT_CHUNK + DIRECT_ALIGN];
+            let start = stage.as_ptr().align_offset(DIRECT_ALIGN);
+            (stage, start)
+        } else {
+            (Vec::new(), 0)
+        };
+        Ok(DirectFile {
+            plain,
+            direct,
+            stage,
+            start,
+            len: 0,
+            written: 0,
+        })
+    }
+
+    /// Writes the staged whole blocks directly, keeping the rest staged.
+    fn write_stage(&mut self) -> io::Result<()> {
+        use std::os::unix::fs::FileExt;
+        let whole = self.len / DIRECT_ALIGN * DIRECT_ALIGN;
+        let data = &self.stage[self.start..self.start + whole];
+        if let Some(direct) = &self.direct {
+            let t = std::time::Instant::now();
+            if direct.write_all_at(data, self.written).is_err()
+                || (whole as f64) < DIRECT_MIN_RATE * t.elapsed().as_secs_f64()
+            {
+                // Unsupported here, or slower than the page cache: stop (rewriting the
+                // chunk the ordinary way, as a failed write may have written part of it).
+                self.direct = None;
+            }
+        }
+        if self.direct.is_none() {
+            self.plain.write_all_at(data, self.written)?;
+        }
+        self.written += whole as u64;
+        let (start, len) = (self.start, self.len);
+        self.stage.copy_within(start + whole..start + len, start);
+        self.len -= whole;
+        Ok(())
+    }
+
+    /// Writes what is still staged; the file is complete afterwards.
+    fn finish(mut self) -> io::Result<()> {
+        use std::os::unix::fs::FileExt;
+        let data = &self.stage[self.start..self.start + self.len];
+        self.plain.write_all_at(data, self.written)?;
+        self.written += self.len as u64;
+        self.len = 0;
+        Ok(())
+    }
+}
+
+#[cfg(unix)]
+impl Write for DirectFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.write_all(buf)?;
+        Ok(buf.len())
+    }
+
+    fn write_all(&mut self, mut buf: &[u8]) -> io::Result<()> {
+        use std::os::unix::fs::FileExt;
+        while !buf.is_empty() {
+            if self.direct.is_none() {
+                // Staged bytes go first (they precede `buf` in the file).
+                let staged = &self.stage[self.start..self.start + self.len];
+                self.plain.write_all_at(staged, self.written)?;
+                self.written += self.len as u64;
+                self.len = 0;
+                self.plain.write_all_at(buf, self.written)?;
+                self.written += buf.len() as u64;
+                return Ok(());
+            }
+            let n = (DIRECT_CHUNK - self.len).min(buf.len());
+            let at = self.start + self.len;
+            self.stage[at..at + n].copy_from_slice(&buf[..n]);
+            self.len += n;
+            buf = &buf[n..];
+            if self.len == DIRECT_CHUNK {
+                self.write_stage()?;
+            }
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
 }
 
 /// Writes the `.ele` file.
@@ -526,9 +716,24 @@ pub fn write_ele<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io:
     b.int(na as i64, 0);
     b.nl()?;
     b.records(mesh.tets.len(), |t, i| {
-        t.int(base + i as i64, 5);
+        let number = base + i as i64;
+        let tet = mesh.tets[i];
+        if na == 0 && number < SMALL && tet.iter().all(|&v| base + i64::from(v) < SMALL) {
+            // The usual line, built on the stack: a tenth of the writing time.
+            let mut line = ShortLine::new();
+            line.uint(number as u32, 5);
+            line.bytes(b"  ");
+            for v in tet {
+                line.bytes(b" ");
+                line.uint((base + i64::from(v)) as u32, 5);
+            }
+            line.bytes(b"\n");
+            line.append_to(t);
+            return;
+        }
+        t.int(number, 5);
         t.str("  ");
-        for &v in &mesh.tets[i] {
+        for &v in &tet {
             t.str(" ");
             t.int(base + i64::from(v), 5);
         }
@@ -952,6 +1157,61 @@ fn eight_digits(u: u32) -> u64 {
     q | ((x - q * 10) << 8)
 }
 
+/// Numbers below this take the fast path of [`Text::int`].
+const SMALL: i64 = 100_000_000;
+
+/// `u` (below [`SMALL`]) right-aligned in `width` (at most 8) columns: the text is the
+/// first `n` of the eight bytes returned with it.
+#[inline(always)]
+fn small_uint_text(u: u32, width: usize) -> ([u8; 8], usize) {
+    let x = eight_digits(u);
+    // Leading zero digits are the low zero bytes (the first in memory); 0 has one digit.
+    let digits = 8 - (x.trailing_zeros() as usize / 8).min(7);
+    let n = digits.max(width);
+    // The last n characters, moved to the front, with the leading zeros as spaces.
+    let text = (x | 0x3030_3030_3030_3030) >> ((8 - n) * 8);
+    let pad = (1u64 << ((n - digits) * 8)) - 1;
+    let text = (text & !pad) | (0x2020_2020_2020_2020 & pad);
+    (text.to_le_bytes(), n)
+}
+
+/// A short line built on the stack from small fields, then appended with one
+/// fixed-size copy: cheaper than growing the text field by field.
+struct ShortLine {
+    bytes: [u8; 64],
+    len: usize,
+}
+
+impl ShortLine {
+    fn new() -> Self {
+        ShortLine {
+            bytes: [0; 64],
+            len: 0,
+        }
+    }
+
+    /// Appends `u` (below [`SMALL`]) right-aligned in `width` (at most 8) columns.
+    #[inline(always)]
+    fn uint(&mut self, u: u32, width: usize) {
+        let (text, n) = small_uint_text(u, width);
+        self.bytes[self.len..self.len + 8].copy_from_slice(&text);
+        self.len += n;
+    }
+
+    #[inline(always)]
+    fn bytes(&mut self, b: &[u8]) {
+        self.bytes[self.len..self.len + b.len()].copy_from_slice(b);
+        self.len += b.len();
+    }
+
+    #[inline(always)]
+    fn append_to(&self, t: &mut Text) {
+        let len = t.buf.len();
+        t.buf.extend_from_slice(&self.bytes);
+        t.buf.truncate(len + self.len);
+    }
+}
+
 /// Text being formatted: a byte buffer and the float formatter's scratch.
 struct Text {
     buf: Vec<u8>,
@@ -991,22 +1251,15 @@ impl Text {
     #[inline]
     fn int(&mut self, v: i64, width: usize) {
         match u32::try_from(v) {
-            Ok(u) if u < 100_000_000 && width <= 8 => self.small_uint(u, width),
+            Ok(u) if i64::from(u) < SMALL && width <= 8 => self.small_uint(u, width),
             _ => self.any_int(v, width),
         }
     }
 
     fn small_uint(&mut self, u: u32, width: usize) {
-        let x = eight_digits(u);
-        // Leading zero digits are the low zero bytes (the first in memory); 0 has one digit.
-        let digits = 8 - (x.trailing_zeros() as usize / 8).min(7);
-        let n = digits.max(width);
-        // The last n characters, moved to the front, with the leading zeros as spaces.
-        let text = (x | 0x3030_3030_3030_3030) >> ((8 - n) * 8);
-        let pad = (1u64 << ((n - digits) * 8)) - 1;
-        let text = (text & !pad) | (0x2020_2020_2020_2020 & pad);
+        let (text, n) = small_uint_text(u, width);
         let len = self.buf.len();
-        self.buf.extend_from_slice(&text.to_le_bytes());
+        self.buf.extend_from_slice(&text);
         self.buf.truncate(len + n);
     }
 
@@ -1476,6 +1729,33 @@ mod tests {
                 format!("|{v:>w$}"),
                 "{v} {w}"
             );
+        }
+    }
+
+    /// Direct output files hold exactly the bytes written, however the writes are cut,
+    /// whether direct I/O works, and when it is given up part-way.
+    #[cfg(unix)]
+    #[test]
+    fn direct_files_hold_what_was_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let data: Vec<u8> = (0..3 * DIRECT_CHUNK + 12345)
+            .map(|i| (i * 7 + i / 4093) as u8)
+            .collect();
+        for (case, give_up_after) in [None, Some(0), Some(DIRECT_CHUNK + 1)].iter().enumerate() {
+            let path = dir.path().join(format!("out{case}"));
+            let mut f = DirectFile::create(&path).unwrap();
+            let (mut at, mut step) = (0, 1);
+            while at < data.len() {
+                if give_up_after.is_some_and(|g| at >= g) {
+                    f.direct = None;
+                }
+                let end = (at + step).min(data.len());
+                f.write_all(&data[at..end]).unwrap();
+                at = end;
+                step = (step * 3 + 5) % 1_500_000;
+            }
+            f.finish().unwrap();
+            assert!(fs::read(&path).unwrap() == data, "case {case}");
         }
     }
 

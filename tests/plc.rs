@@ -1,0 +1,519 @@
+//! Tests of the PLC pipeline (`tetcdt -p`) on the small models in `data/plc/`.
+//!
+//! - Every model meshes (exit 0) and passes our own `--check`.
+//! - Where python3 with numpy and the shared referee `validate_mesh.py` are found
+//!   (`$TETCDT_TOOLS`, else `../shared/tools` next to the repository), every mesh also
+//!   passes the referee; otherwise that part is skipped with a note.
+//! - Where TetGen adds no Steiner points and its mesh is valid, our tets are exactly
+//!   TetGen's (`data/plc/ref/`, written by `scripts/gen-plc-reference.sh`), nodes matched
+//!   by coordinates.
+//! - Switches: `-M` keeps coplanar quads apart, `-A` writes region attributes, `-c` keeps
+//!   the convex hull, and a hole point carves its cavity.
+//!
+//! The models are written by `scripts/gen-plc-models.py` (see `data/plc/README.md` and
+//! `data/plc/LICENSES.md`).
+
+use assert_cmd::Command;
+use std::collections::{BTreeSet, HashMap};
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+fn tetcdt() -> Command {
+    Command::cargo_bin("tetcdt").unwrap()
+}
+
+fn plc_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join("plc")
+}
+
+/// The model files in `data/plc/` (not in `ref/`), sorted.
+fn models() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = fs::read_dir(plc_dir())
+        .expect("data/plc/ is missing (python3 scripts/gen-plc-models.py)")
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.is_file()
+                && matches!(
+                    p.extension().and_then(|e| e.to_str()),
+                    Some("off" | "poly" | "smesh" | "obj" | "stl" | "ply" | "mesh")
+                )
+        })
+        .collect();
+    v.sort();
+    assert!(
+        v.len() >= 20,
+        "expected the PLC models in {}",
+        plc_dir().display()
+    );
+    v
+}
+
+fn model(name: &str) -> PathBuf {
+    let p = plc_dir().join(name);
+    assert!(p.is_file(), "{} is missing", p.display());
+    p
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+/// Runs `tetcdt ARGS -o PREFIX MODEL`; returns (exit code, stderr).
+fn run(model: &Path, prefix: &Path, args: &[&str]) -> (i32, String) {
+    let out = tetcdt()
+        .args(args)
+        .arg("-o")
+        .arg(prefix)
+        .arg(model)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).trim().to_owned(),
+    )
+}
+
+/// Meshes `model` with `args`, panicking with tetcdt's message on failure; returns the
+/// output prefix inside `dir`.
+fn mesh(model: &Path, dir: &Path, tag: &str, args: &[&str]) -> PathBuf {
+    let prefix = dir.join(tag);
+    let (code, err) = run(model, &prefix, args);
+    assert_eq!(
+        code,
+        0,
+        "tetcdt {} {}: exit {code}: {err}",
+        args.join(" "),
+        file_name(model)
+    );
+    prefix
+}
+
+/// The data rows of a TetGen file: comments stripped, blank lines dropped.
+fn rows(path: &Path) -> Vec<Vec<String>> {
+    fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .map(|l| l.split('#').next().unwrap_or(""))
+        .map(|l| l.split_whitespace().map(str::to_owned).collect::<Vec<_>>())
+        .filter(|r| !r.is_empty())
+        .collect()
+}
+
+fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
+    let mut s = prefix.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// A mesh read back from `PREFIX.node` / `PREFIX.ele`: 0-based tets, per-tet attributes.
+struct Mesh {
+    points: Vec<[f64; 3]>,
+    tets: Vec<[usize; 4]>,
+    attrs: Vec<Vec<f64>>,
+    nattr: usize,
+}
+
+fn read_mesh(prefix: &Path) -> Mesh {
+    let node = with_ext(prefix, "node");
+    let r = rows(&node);
+    let n: usize = r[0][0].parse().unwrap();
+    let first: usize = if n > 0 { r[1][0].parse().unwrap() } else { 0 };
+    let points = r[1..=n]
+        .iter()
+        .map(|x| {
+            [
+                x[1].parse().unwrap(),
+                x[2].parse().unwrap(),
+                x[3].parse().unwrap(),
+            ]
+        })
+        .collect();
+    let ele = with_ext(prefix, "ele");
+    let r = rows(&ele);
+    let m: usize = r[0][0].parse().unwrap();
+    let nattr: usize = r[0].get(2).map_or(0, |s| s.parse().unwrap());
+    let mut tets = Vec::with_capacity(m);
+    let mut attrs = Vec::with_capacity(m);
+    for x in &r[1..=m] {
+        let mut t = [0usize; 4];
+        for (j, slot) in t.iter_mut().enumerate() {
+            *slot = x[1 + j].parse::<usize>().unwrap() - first;
+        }
+        tets.push(t);
+        attrs.push(x[5..5 + nattr].iter().map(|s| s.parse().unwrap()).collect());
+    }
+    Mesh {
+        points,
+        tets,
+        attrs,
+        nattr,
+    }
+}
+
+/// The number of rows a TetGen file announces in its header.
+fn count(prefix: &Path, ext: &str) -> usize {
+    rows(&with_ext(prefix, ext))[0][0].parse().unwrap()
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn signed_volume(m: &Mesh, t: &[usize; 4]) -> f64 {
+    let [a, b, c, d] = t.map(|i| m.points[i]);
+    let (u, v, w) = (sub(a, d), sub(b, d), sub(c, d));
+    (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0]))
+        / 6.0
+}
+
+fn volume(m: &Mesh) -> f64 {
+    m.tets.iter().map(|t| signed_volume(m, t).abs()).sum()
+}
+
+fn centroid(m: &Mesh, t: &[usize; 4]) -> [f64; 3] {
+    std::array::from_fn(|k| t.iter().map(|&i| m.points[i][k] / 4.0).sum())
+}
+
+/// A point's key: the bits of its coordinates (-0 taken as 0).
+fn key(p: [f64; 3]) -> [u64; 3] {
+    p.map(|x| (x + 0.0).to_bits())
+}
+
+/// The tets as sets of vertex coordinates.
+fn tet_keys(m: &Mesh) -> BTreeSet<[[u64; 3]; 4]> {
+    m.tets
+        .iter()
+        .map(|t| {
+            let mut k = t.map(|i| key(m.points[i]));
+            k.sort_unstable();
+            k
+        })
+        .collect()
+}
+
+/// The shared referee and a python3 with numpy, if both are found.
+fn validator() -> Option<PathBuf> {
+    let candidates = [
+        std::env::var_os("TETCDT_TOOLS").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/tools")),
+    ];
+    let script = candidates
+        .into_iter()
+        .flatten()
+        .map(|d| d.join("validate_mesh.py"))
+        .find(|p| p.is_file());
+    let Some(script) = script else {
+        eprintln!("note: validate_mesh.py not found (set TETCDT_TOOLS): skipping the referee");
+        return None;
+    };
+    let numpy = std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !numpy {
+        eprintln!("note: python3 with numpy not found: skipping the referee");
+        return None;
+    }
+    Some(script)
+}
+
+/// Runs `f` on every item on two threads (the machine's cores are shared); returns the
+/// failure messages, in the items' order.
+fn for_each_parallel<T: Sync>(items: &[T], f: impl Fn(&T) -> Option<String> + Sync) -> Vec<String> {
+    let next = Mutex::new(0usize);
+    let found = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = {
+                    let mut n = next.lock().unwrap();
+                    *n += 1;
+                    *n - 1
+                };
+                let Some(item) = items.get(i) else { break };
+                if let Some(msg) = f(item) {
+                    found.lock().unwrap().push((i, msg));
+                }
+            });
+        }
+    });
+    let mut found = found.into_inner().unwrap();
+    found.sort();
+    found.into_iter().map(|(_, m)| m).collect()
+}
+
+#[test]
+fn every_model_meshes_and_passes_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = models();
+    let failures = for_each_parallel(&models, |m| {
+        let name = file_name(m);
+        let prefix = dir.path().join(&name);
+        let (code, err) = run(m, &prefix, &["-pQ", "--check"]);
+        if code != 0 {
+            return Some(format!("{name}: `tetcdt -pQ --check` exit {code}: {err}"));
+        }
+        if count(&prefix, "ele") == 0 {
+            return Some(format!("{name}: no tets"));
+        }
+        None
+    });
+    assert!(
+        failures.is_empty(),
+        "{} of {} models fail:\n{}",
+        failures.len(),
+        models.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn every_model_passes_the_validator() {
+    let Some(script) = validator() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let models = models();
+    let failures = for_each_parallel(&models, |m| {
+        let name = file_name(m);
+        let prefix = dir.path().join(&name);
+        let (code, err) = run(m, &prefix, &["-pQ"]);
+        if code != 0 {
+            return Some(format!("{name}: `tetcdt -pQ` exit {code}: {err}"));
+        }
+        let out = std::process::Command::new("python3")
+            .arg(&script)
+            .arg(m)
+            .arg(&prefix)
+            .output()
+            .unwrap();
+        if out.status.success() {
+            return None;
+        }
+        let text = String::from_utf8_lossy(&out.stdout);
+        let problems: Vec<&str> = text
+            .lines()
+            .filter(|l| l.starts_with("problem:") || l.starts_with("steiner:"))
+            .collect();
+        Some(format!(
+            "{name}: validate_mesh.py: {} [{}] {}",
+            text.lines().last().unwrap_or(""),
+            problems.join("; "),
+            String::from_utf8_lossy(&out.stderr).trim()
+        ))
+    });
+    assert!(
+        failures.is_empty(),
+        "{} of {} models fail the referee:\n{}",
+        failures.len(),
+        models.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn identical_to_tetgen_where_it_adds_no_steiner_points() {
+    let ref_dir = plc_dir().join("ref");
+    let mut refs: Vec<PathBuf> = fs::read_dir(&ref_dir)
+        .expect("data/plc/ref/ is missing (scripts/gen-plc-reference.sh)")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("ele"))
+        .collect();
+    refs.sort();
+    assert!(
+        refs.len() >= 10,
+        "expected TetGen references in {}",
+        ref_dir.display()
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let failures = for_each_parallel(&refs, |ele| {
+        // NAME.1.ele -> NAME.{off,poly,smesh}
+        let stem = file_name(ele);
+        let stem = stem.strip_suffix(".1.ele").unwrap();
+        let Some(input) = ["off", "poly", "smesh"]
+            .iter()
+            .map(|e| plc_dir().join(format!("{stem}.{e}")))
+            .find(|p| p.is_file())
+        else {
+            return Some(format!("{stem}: reference without a model"));
+        };
+        let theirs = read_mesh(&ref_dir.join(format!("{stem}.1")));
+        let prefix = dir.path().join(stem);
+        let (code, err) = run(&input, &prefix, &["-pQ"]);
+        if code != 0 {
+            return Some(format!("{stem}: `tetcdt -pQ` exit {code}: {err}"));
+        }
+        let ours = read_mesh(&prefix);
+        let node_keys = |m: &Mesh| m.points.iter().map(|&p| key(p)).collect::<BTreeSet<_>>();
+        if node_keys(&ours) != node_keys(&theirs) {
+            return Some(format!(
+                "{stem}: our {} nodes are not TetGen's {} (input vertices only): we add Steiner points",
+                ours.points.len(),
+                theirs.points.len()
+            ));
+        }
+        let (a, b) = (tet_keys(&ours), tet_keys(&theirs));
+        if a == b {
+            return None;
+        }
+        let index: HashMap<[u64; 3], usize> = theirs
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (key(p), i))
+            .collect();
+        let show = |k: &[[u64; 3]; 4]| {
+            let mut ids = k.map(|p| index[&p]);
+            ids.sort_unstable();
+            format!("{ids:?}")
+        };
+        let extra: Vec<String> = a.difference(&b).take(4).map(show).collect();
+        let missing: Vec<String> = b.difference(&a).take(4).map(show).collect();
+        Some(format!(
+            "{stem}: {} tets (TetGen {}); {} of ours not in TetGen's, e.g. {} ; {} of TetGen's missing, e.g. {} (TetGen's node numbers, 0-based)",
+            a.len(),
+            b.len(),
+            a.difference(&b).count(),
+            extra.join(" "),
+            b.difference(&a).count(),
+            missing.join(" ")
+        ))
+    });
+    assert!(
+        failures.is_empty(),
+        "{} of {} models differ from TetGen:\n{}",
+        failures.len(),
+        refs.len(),
+        failures.join("\n")
+    );
+}
+
+/// The faces of gridbox_3 (a 3x3x3 box) are 3x3 grids of unit quads. Merged (the default),
+/// each face is one facet and only the box's 12 edges (split at the grid vertices: 36
+/// pieces) are segments; with -M every quad edge is one (108). The number of boundary
+/// triangles is 2 per quad either way: without Steiner points a triangulation of the same
+/// vertices has the same number of triangles. TetGen 1.5 gives the same counts.
+#[test]
+fn no_merge_keeps_every_quad_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = model("gridbox_3.smesh");
+    let merged = mesh(&m, dir.path(), "merged", &["-pQ", "--check"]);
+    let apart = mesh(&m, dir.path(), "apart", &["-pQM", "--check"]);
+    let (e0, e1) = (count(&merged, "edge"), count(&apart, "edge"));
+    let (f0, f1) = (count(&merged, "face"), count(&apart, "face"));
+    assert!(e1 > e0, "-M: {e1} segments, not more than the merged {e0}");
+    assert_eq!((e0, e1), (36, 108), "segments merged / -M");
+    assert_eq!((f0, f1), (108, 108), "boundary faces merged / -M");
+    assert_eq!(read_mesh(&merged).points.len(), 56, "no Steiner points");
+    assert_eq!(
+        read_mesh(&apart).points.len(),
+        56,
+        "no Steiner points with -M"
+    );
+}
+
+#[test]
+fn region_attributes_with_a() {
+    let dir = tempfile::tempdir().unwrap();
+    // box [0,2]x[0,1]x[0,1] cut at x = 1: attribute 10 for x < 1, 20 for x > 1
+    let m = model("box_internal_facet.poly");
+    let plain = read_mesh(&mesh(&m, dir.path(), "plain", &["-pQ"]));
+    assert_eq!(plain.nattr, 0, "no attributes without -A");
+    let a = read_mesh(&mesh(&m, dir.path(), "attr", &["-pQA", "--check"]));
+    assert_eq!(a.nattr, 1, "one attribute per tet with -A");
+    let mut seen = BTreeSet::new();
+    for (t, attr) in a.tets.iter().zip(&a.attrs) {
+        let c = centroid(&a, t);
+        let want = if c[0] < 1.0 { 10.0 } else { 20.0 };
+        assert_eq!(attr[0], want, "tet {t:?} with centroid {c:?}");
+        seen.insert(attr[0] as i64);
+    }
+    assert_eq!(seen, BTreeSet::from([10, 20]));
+    let vol = |which: f64| -> f64 {
+        a.tets
+            .iter()
+            .zip(&a.attrs)
+            .filter(|(_, x)| x[0] == which)
+            .map(|(t, _)| signed_volume(&a, t).abs())
+            .sum()
+    };
+    assert!((vol(10.0) - 1.0).abs() < 1e-12 && (vol(20.0) - 1.0).abs() < 1e-12);
+
+    // the Figure 4 box cut by a nearly flat facet: 1 above, 2 below
+    let m = model("fig4_split.poly");
+    let a = read_mesh(&mesh(&m, dir.path(), "fig4", &["-pQA", "--check"]));
+    assert_eq!(a.nattr, 1);
+    for (t, attr) in a.tets.iter().zip(&a.attrs) {
+        let c = centroid(&a, t);
+        if c[2].abs() > 0.01 {
+            let want = if c[2] > 0.0 { 1.0 } else { 2.0 };
+            assert_eq!(attr[0], want, "fig4_split: tet {t:?} with centroid {c:?}");
+        }
+    }
+}
+
+/// ushape.poly has volume 2.5; its convex hull is the box [0,3]x[0,1]x[0,1].
+#[test]
+fn convex_hull_kept_with_c() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = model("ushape.poly");
+    let carved = read_mesh(&mesh(&m, dir.path(), "carved", &["-pQ", "--check"]));
+    let hull_prefix = mesh(&m, dir.path(), "hull", &["-pQc", "--check"]);
+    let hull = read_mesh(&hull_prefix);
+    assert!(
+        (volume(&carved) - 2.5).abs() < 1e-12,
+        "volume {}",
+        volume(&carved)
+    );
+    assert!(
+        (volume(&hull) - 3.0).abs() < 1e-12,
+        "volume with -c {}",
+        volume(&hull)
+    );
+    assert!(hull.tets.len() > carved.tets.len());
+    if let Some(script) = validator() {
+        let out = std::process::Command::new("python3")
+            .arg(&script)
+            .arg(&m)
+            .arg(&hull_prefix)
+            .arg("--hull")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "validate_mesh.py --hull: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+}
+
+/// box_cavity.poly: the box [0,4]^3 with the cavity [1,2.5]x[1,3]x[1.5,3] and a hole
+/// point in it; 59.5 remains.
+#[test]
+fn hole_is_carved() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = model("box_cavity.poly");
+    let mesh = read_mesh(&mesh(&m, dir.path(), "cavity", &["-pQA", "--check"]));
+    assert!(
+        (volume(&mesh) - 59.5).abs() < 1e-9,
+        "volume {}",
+        volume(&mesh)
+    );
+    for t in &mesh.tets {
+        let c = centroid(&mesh, t);
+        let inside = (1.0..=2.5).contains(&c[0])
+            && (1.0..=3.0).contains(&c[1])
+            && (1.5..=3.0).contains(&c[2]);
+        assert!(!inside, "tet {t:?} (centroid {c:?}) lies in the hole");
+    }
+    // the one region left has attribute 5
+    assert_eq!(mesh.nattr, 1);
+    assert!(
+        mesh.attrs.iter().all(|a| a[0] == 5.0),
+        "attributes other than 5"
+    );
+}
