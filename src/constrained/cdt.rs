@@ -45,20 +45,14 @@ impl Cdt {
     /// The face `(a, b, c)` of the mesh, as seen from one of its two tets, if present.
     pub fn find_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> Option<FaceRef> {
         let mut star = std::mem::take(&mut self.scratch);
-        self.dt.star(a, &mut star);
-        let mut found = None;
-        for &t in &star {
-            let v = self.dt.mesh.verts(t);
-            if v.contains(&b) && v.contains(&c) {
-                let i = (0..4)
-                    .find(|&i| v[i] != a && v[i] != b && v[i] != c)
-                    .unwrap_or(0);
-                found = Some(FaceRef::new(t, i));
-                break;
-            }
-        }
+        let t = self
+            .dt
+            .find_around(a, &mut star, |v| v.contains(&b) && v.contains(&c));
         self.scratch = star;
-        found
+        let t = t?;
+        let v = self.dt.mesh.verts(t);
+        let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c)?;
+        Some(FaceRef::new(t, i))
     }
 
     /// True if `u`–`v` is a mesh edge.

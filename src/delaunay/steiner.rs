@@ -56,6 +56,9 @@ impl Delaunay {
             return;
         };
         out.push(t0);
+        // Stars of most vertices are small, but vertices of long thin features can have
+        // thousands of tets: past a few dozen, membership goes through a hash set.
+        let mut seen: rustc_hash::FxHashSet<TetId> = rustc_hash::FxHashSet::default();
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -67,17 +70,64 @@ impl Delaunay {
                     continue;
                 }
                 let n = self.mesh.adj(FaceRef::new(t, i)).tet();
-                if !out.contains(&n) {
+                let new = if out.len() < 48 {
+                    !out.contains(&n)
+                } else {
+                    if seen.is_empty() {
+                        seen.extend(out.iter().copied());
+                    }
+                    seen.insert(n)
+                };
+                if new {
                     out.push(n);
                 }
             }
         }
     }
 
+    /// The first tet around vertex `u` (in a walk over its star) for which `hit` holds.
+    pub fn find_around(
+        &self,
+        u: VertexId,
+        scratch: &mut Vec<TetId>,
+        mut hit: impl FnMut([VertexId; 4]) -> bool,
+    ) -> Option<TetId> {
+        scratch.clear();
+        scratch.push(self.mesh.vertex_tet(u)?);
+        // Most stars are small; past a few dozen tets, membership uses a hash set.
+        let mut seen: rustc_hash::FxHashSet<TetId> = rustc_hash::FxHashSet::default();
+        let mut k = 0;
+        while k < scratch.len() {
+            let t = scratch[k];
+            k += 1;
+            let tv = self.mesh.verts(t);
+            if hit(tv) {
+                return Some(t);
+            }
+            for (i, &x) in tv.iter().enumerate() {
+                if x == u {
+                    continue;
+                }
+                let n = self.mesh.adj(FaceRef::new(t, i)).tet();
+                let new = if scratch.len() < 48 {
+                    !scratch.contains(&n)
+                } else {
+                    if seen.is_empty() {
+                        seen.extend(scratch.iter().copied());
+                    }
+                    seen.insert(n)
+                };
+                if new {
+                    scratch.push(n);
+                }
+            }
+        }
+        None
+    }
+
     /// True if `u`–`v` is an edge of the mesh.
     pub fn has_edge(&self, u: VertexId, v: VertexId, scratch: &mut Vec<TetId>) -> bool {
-        self.star(u, scratch);
-        scratch.iter().any(|&t| self.mesh.verts(t).contains(&v))
+        self.find_around(u, scratch, |tv| tv.contains(&v)).is_some()
     }
 }
 

@@ -580,21 +580,35 @@ const O_DIRECT: Option<i32> = None;
 const DIRECT_ALIGN: usize = 4096;
 /// Bytes per direct write.
 const DIRECT_CHUNK: usize = 4 << 20;
-/// Direct writes slower than this (bytes per second) go back to the page cache.
-const DIRECT_MIN_RATE: f64 = 1e9;
+/// Chunks written to compare direct I/O with the page cache, half each way.
+const DIRECT_PROBES: usize = 4;
+/// How much slower than the page cache direct I/O may be on trial and still be kept:
+/// the trial's page-cache chunks often land in pages just freed, which are cheap, while
+/// the rest of the file needs fresh ones, up to twenty times dearer. (Measured per 4 MB
+/// chunk: direct 2-2.7 ms; page cache 0.8-1.1 ms on trial, 19 ms on fresh pages; the
+/// whole output took a third of the time direct.) A slow disk loses by far more.
+const DIRECT_TOLERANCE: f64 = 4.0;
 
 /// A big output file, written with direct I/O (bypassing the page cache) where the file
-/// system supports it and the disk keeps up.
+/// system supports it and that is faster.
 ///
 /// Copying hundreds of megabytes into freshly allocated page-cache pages can cost
 /// several times more than the disk write itself (on the virtual machines this was
-/// tuned on, 2.5 ms per megabyte against 0.3 ms); direct writes skip the copy. Data
+/// tuned on, 2.5 ms per megabyte against 0.3 ms), and direct writes skip the copy; but
+/// on a slow disk, or where page-cache pages are cheap, the page cache wins. So the
+/// first chunks are written alternately both ways, and direct I/O writes the rest
+/// unless its best chunk (the best shrugs off a preempted one) was much slower. Data
 /// are staged in an aligned buffer and written in aligned chunks; the unaligned tail,
-/// and everything after a direct write fails or runs slow, takes the ordinary path.
+/// and everything after a failed direct write, take the ordinary path.
 #[cfg(unix)]
 struct DirectFile {
     plain: File,
+    /// The file opened for direct I/O, while that is in use or on trial.
     direct: Option<File>,
+    /// Whole chunks written so far while comparing the two ways.
+    probes: usize,
+    /// The fastest chunk each way so far, in seconds: direct, then page cache.
+    fastest: [f64; 2],
     stage: Vec<u8>,
     /// Where the aligned window starts in `stage`.
     start: usize,
@@ -626,6 +640,8 @@ impl DirectFile {
         Ok(DirectFile {
             plain,
             direct,
+            probes: 0,
+            fastest: [f64::INFINITY; 2],
             stage,
             start,
             len: 0,
@@ -638,18 +654,30 @@ impl DirectFile {
         use std::os::unix::fs::FileExt;
         let whole = self.len / DIRECT_ALIGN * DIRECT_ALIGN;
         let data = &self.stage[self.start..self.start + whole];
-        if let Some(direct) = &self.direct {
-            let t = std::time::Instant::now();
-            if direct.write_all_at(data, self.written).is_err()
-                || (whole as f64) < DIRECT_MIN_RATE * t.elapsed().as_secs_f64()
-            {
-                // Unsupported here, or slower than the page cache: stop (rewriting the
-                // chunk the ordinary way, as a failed write may have written part of it).
+        let trial = self.probes < DIRECT_PROBES;
+        // On trial, even chunks go direct and odd ones through the page cache.
+        let go_direct = self.direct.is_some() && !(trial && self.probes % 2 == 1);
+        let t = std::time::Instant::now();
+        let mut done = false;
+        if let (true, Some(direct)) = (go_direct, &self.direct) {
+            done = direct.write_all_at(data, self.written).is_ok();
+            if !done {
+                // Unsupported here: the page cache from now on, rewriting the chunk (a
+                // failed write may have written part of it).
                 self.direct = None;
             }
         }
-        if self.direct.is_none() {
+        if !done {
             self.plain.write_all_at(data, self.written)?;
+        }
+        if trial && self.direct.is_some() {
+            let way = usize::from(!go_direct);
+            self.fastest[way] = self.fastest[way].min(t.elapsed().as_secs_f64());
+            self.probes += 1;
+            if self.probes == DIRECT_PROBES && self.fastest[0] > DIRECT_TOLERANCE * self.fastest[1]
+            {
+                self.direct = None;
+            }
         }
         self.written += whole as u64;
         let (start, len) = (self.start, self.len);
@@ -719,7 +747,7 @@ pub fn write_ele<W: Write>(out: &mut W, mesh: &MeshOut, w: &WriteOptions) -> io:
         let number = base + i as i64;
         let tet = mesh.tets[i];
         if na == 0 && number < SMALL && tet.iter().all(|&v| base + i64::from(v) < SMALL) {
-            // The usual line, built on the stack: a tenth of the writing time.
+            // The usual line, built on the stack: this halved the formatting time.
             let mut line = ShortLine::new();
             line.uint(number as u32, 5);
             line.bytes(b"  ");
