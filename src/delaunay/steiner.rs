@@ -51,38 +51,8 @@ impl Delaunay {
 
     /// Collects the live tets (ghosts included) incident to vertex `v` into `out`.
     pub fn star(&self, v: VertexId, out: &mut Vec<TetId>) {
-        out.clear();
-        let Some(t0) = self.mesh.vertex_tet(v) else {
-            return;
-        };
-        out.push(t0);
-        // Stars of most vertices are small, but vertices of long thin features can have
-        // thousands of tets: past a few dozen, membership goes through a hash set.
-        let mut seen: rustc_hash::FxHashSet<TetId> = rustc_hash::FxHashSet::default();
-        let mut k = 0;
-        while k < out.len() {
-            let t = out[k];
-            k += 1;
-            let tv = self.mesh.verts(t);
-            for (i, &x) in tv.iter().enumerate() {
-                // Faces containing v are those opposite the other vertices.
-                if x == v {
-                    continue;
-                }
-                let n = self.mesh.adj(FaceRef::new(t, i)).tet();
-                let new = if out.len() < 48 {
-                    !out.contains(&n)
-                } else {
-                    if seen.is_empty() {
-                        seen.extend(out.iter().copied());
-                    }
-                    seen.insert(n)
-                };
-                if new {
-                    out.push(n);
-                }
-            }
-        }
+        // A walk that never stops early visits the whole star and leaves it in `out`.
+        let _ = self.find_around(v, out, |_| false);
     }
 
     /// The first tet around vertex `u` (in a walk over its star) for which `hit` holds.
