@@ -100,7 +100,7 @@ pub fn recover_segments(
                 )));
             }
             let [a, b] = ends[pc.seg];
-            let s = split_parameter(dt, pc, [a, b], &acute);
+            let s = split_parameter(dt, pc, [a, b], &acute, &mut scratch);
             let pa = dt.points[a as usize];
             let pb = dt.points[b as usize];
             let x: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
@@ -204,12 +204,18 @@ fn acute_vertices(dt: &Delaunay, ends: &[[VertexId; 2]]) -> Vec<bool> {
 
 /// Where to split a piece: on a power-of-two sphere around an acute segment endpoint,
 /// else at the middle.
-fn split_parameter(dt: &Delaunay, pc: Piece, [a, b]: [VertexId; 2], acute: &[bool]) -> f64 {
+fn split_parameter(
+    dt: &Delaunay,
+    pc: Piece,
+    [a, b]: [VertexId; 2],
+    acute: &[bool],
+    scratch: &mut Vec<crate::mesh::TetId>,
+) -> f64 {
     let mid = 0.5 * (pc.s0 + pc.s1);
     let from_a = pc.u == a && acute[a as usize];
     let from_b = pc.v == b && acute[b as usize];
     if from_a == from_b {
-        return mid;
+        return reference_split(dt, pc, [a, b], scratch).unwrap_or(mid);
     }
     let pa = dt.points[a as usize];
     let pb = dt.points[b as usize];
@@ -227,6 +233,53 @@ fn split_parameter(dt: &Delaunay, pc: Piece, [a, b]: [VertexId; 2], acute: &[boo
     } else {
         mid
     }
+}
+
+/// The split point from the piece's reference point (Si & Gärtner): the neighbour of
+/// its end `u` that sees the piece under the widest angle from inside its diametral
+/// sphere, projected onto the segment. Both halves then leave that vertex on or outside
+/// their diametral spheres, so one split often suffices. The projection is kept away
+/// from the piece's ends so that no needlessly short edge appears.
+fn reference_split(
+    dt: &Delaunay,
+    pc: Piece,
+    [a, b]: [VertexId; 2],
+    scratch: &mut Vec<crate::mesh::TetId>,
+) -> Option<f64> {
+    let p = |v: VertexId| dt.points[v as usize];
+    let (pu, pv) = (p(pc.u), p(pc.v));
+    let (pa, pb) = (p(a), p(b));
+    let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+    let dd: f64 = d.iter().map(|x| x * x).sum();
+    if !(dd > 0.0 && dd.is_finite()) {
+        return None;
+    }
+    dt.star(pc.u, scratch);
+    let mut best: Option<(f64, f64)> = None; // (cosine of the angle, parameter)
+    for &t in scratch.iter() {
+        for &x in &dt.mesh.verts(t) {
+            if x == crate::mesh::GHOST || x == pc.u || x == pc.v {
+                continue;
+            }
+            let q = p(x);
+            let e: [f64; 3] = std::array::from_fn(|k| pu[k] - q[k]);
+            let f: [f64; 3] = std::array::from_fn(|k| pv[k] - q[k]);
+            let dot: f64 = (0..3).map(|k| e[k] * f[k]).sum();
+            if dot >= 0.0 {
+                continue; // not inside the diametral sphere
+            }
+            let ne: f64 = e.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let nf: f64 = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let cos = dot / (ne * nf);
+            let s = (0..3).map(|k| (q[k] - pa[k]) * d[k]).sum::<f64>() / dd;
+            if best.is_none_or(|(c, _)| cos < c) {
+                best = Some((cos, s));
+            }
+        }
+    }
+    let (_, s) = best?;
+    let w = pc.s1 - pc.s0;
+    Some(s.clamp(pc.s0 + 0.1 * w, pc.s1 - 0.1 * w))
 }
 
 #[cfg(test)]
