@@ -59,41 +59,11 @@ pub fn incircle_sos(p: [&[f64; 2]; 4], ids: [u32; 4]) -> Sign {
     if det != 0.0 {
         return Sign::of(det);
     }
-    let mut order = [0usize, 1, 2, 3];
-    let mut swaps = 0u32;
-    for n in (1..4).rev() {
-        for i in 0..n {
-            if ids[order[i]] > ids[order[i + 1]] {
-                order.swap(i, i + 1);
-                swaps += 1;
-            }
-        }
-    }
-    let q = order.map(|k| p[k]);
     // The determinant |x y x²+y²−w 1| of the sorted rows loses w_k times the cofactor
     // (−1)^k · orient2d(others) of its lift entry; the lowest index dominates.
-    for k in 0..4 {
-        let mut rest = [q[0]; 3];
-        let mut j = 0;
-        for (i, pt) in q.iter().enumerate() {
-            if i != k {
-                rest[j] = pt;
-                j += 1;
-            }
-        }
-        let o = robust::orient2d(c2(rest[0]), c2(rest[1]), c2(rest[2]));
-        if o != 0.0 {
-            let mut s = Sign::of(o).flip();
-            if k % 2 == 1 {
-                s = s.flip();
-            }
-            if swaps % 2 == 1 {
-                s = s.flip();
-            }
-            return s;
-        }
-    }
-    Sign::Zero
+    crate::geom::predicates::perturbed_sign(p, ids, |r: &[&[f64; 2]; 3]| {
+        Sign::of(robust::orient2d(c2(r[0]), c2(r[1]), c2(r[2]))).flip()
+    })
 }
 
 /// The predicates of one mode, on local vertex numbers.

@@ -295,19 +295,7 @@ fn attempt(
                     }
                 }
             };
-        for ring in &f.rings {
-            for k in 0..ring.len() {
-                add_edge(
-                    ring[k],
-                    ring[(k + 1) % ring.len()],
-                    &mut verts,
-                    &mut constraints,
-                );
-            }
-        }
-        for s in &f.inner_segments {
-            add_edge(s[0], s[1], &mut verts, &mut constraints);
-        }
+        for_each_edge(f, |a, b| add_edge(a, b, &mut verts, &mut constraints));
         for &v in &f.isolated {
             verts.push(inv[v as usize]);
         }
@@ -696,7 +684,7 @@ fn regions_of(
 /// Carves the mesh and puts it in output form.
 fn finish(
     plc: &Plc,
-    _prep: &PreparedPlc,
+    prep: &PreparedPlc,
     mut cdt: Cdt,
     seg_markers: &FxHashMap<(VertexId, VertexId), i32>,
     opts: &PlcOptions,
@@ -754,7 +742,7 @@ fn finish(
         };
         // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
         let v = cdt.dt.mesh.face_verts(t, i).map(orig);
-        subfaces.push((v, _prep.facets[f as usize].marker));
+        subfaces.push((v, prep.facets[f as usize].marker));
     }
     let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
         .iter()

@@ -237,10 +237,25 @@ pub fn insphere_sos(p: [&Point; 5], ids: [u32; 5]) -> Sign {
 
 /// The perturbed sign of Shewchuk's (unnegated) insphere when the exact value is zero.
 fn insphere_perturbed(p: [&Point; 5], ids: [u32; 5]) -> Sign {
-    let mut order = [0usize, 1, 2, 3, 4];
+    perturbed_sign(p, ids, |r: &[&Point; 4]| {
+        Sign::of(robust::orient3d(c(r[0]), c(r[1]), c(r[2]), c(r[3])))
+    })
+}
+
+/// The sign of a lifted determinant (insphere, incircle) whose exact value is zero, under
+/// TetGen's perturbation: each point's lift is lowered by a weight that dominates all
+/// weights of higher indices. With the points sorted by index (tracking the parity of the
+/// sort), the coefficient of the k-th weight is (-1)^k times the orientation of the other
+/// points, given by `orient`; the first that is not zero decides.
+pub(crate) fn perturbed_sign<T: Copy, const N: usize, const M: usize>(
+    p: [T; N],
+    ids: [u32; N],
+    orient: impl Fn(&[T; M]) -> Sign,
+) -> Sign {
+    let mut order: [usize; N] = std::array::from_fn(|i| i);
     let mut swaps = 0u32;
-    // Bubble sort: we need the parity of the permutation, and five items are few.
-    for n in (1..5).rev() {
+    // Bubble sort: we need the parity of the permutation, and the items are few.
+    for n in (1..N).rev() {
         for i in 0..n {
             if ids[order[i]] > ids[order[i + 1]] {
                 order.swap(i, i + 1);
@@ -248,28 +263,15 @@ fn insphere_perturbed(p: [&Point; 5], ids: [u32; 5]) -> Sign {
             }
         }
     }
-    let q = order.map(|k| p[k]);
-    // The coefficient of the weight of the k-th lowest index is (-1)^k times the
-    // orientation of the other four; the lowest index has the dominant weight.
-    for k in 0..5 {
-        let mut rest = [q[0]; 4];
-        let mut j = 0;
-        for (i, pt) in q.iter().enumerate() {
-            if i != k {
-                rest[j] = pt;
-                j += 1;
-            }
-        }
-        let o = robust::orient3d(c(rest[0]), c(rest[1]), c(rest[2]), c(rest[3]));
-        if o != 0.0 {
-            let mut s = Sign::of(o);
-            if k % 2 == 1 {
-                s = s.flip();
-            }
-            if swaps % 2 == 1 {
-                s = s.flip();
-            }
-            return s;
+    for k in 0..N {
+        let rest: [T; M] = std::array::from_fn(|j| p[order[if j < k { j } else { j + 1 }]]);
+        let s = orient(&rest);
+        if s != Sign::Zero {
+            return if (k % 2 == 1) != (swaps % 2 == 1) {
+                s.flip()
+            } else {
+                s
+            };
         }
     }
     Sign::Zero
