@@ -106,6 +106,13 @@ fn debug() -> bool {
     std::env::var_os("TETCDT_DEBUG").is_some()
 }
 
+/// The most Steiner points on polygons before giving up: far more than polygons that are
+/// nearly flat need (the paper's worst case needed 103), so reaching it means the
+/// polygons are not nearly flat and more points will not help.
+fn max_facet_points(plc: &Plc) -> usize {
+    (4 * plc.points.len()).max(1000)
+}
+
 /// Marks the failure to triangulate a merged group in one plane (then split).
 const UNFLAT_GROUP: &str = "merged facets ";
 
@@ -176,6 +183,7 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
                 }
                 if stats.restarts > MAX_RESTARTS
                     || facet_points.len() + more.len() > opts.max_steiner
+                    || facet_points.len() + more.len() > max_facet_points(plc)
                 {
                     return Err(MeshError::Failed(format!(
                         "polygons that are not flat still conflict after {} Steiner points on them",
