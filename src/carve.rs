@@ -103,3 +103,94 @@ fn containing_tet(cdt: &mut Cdt, p: &Point) -> Option<TetId> {
         Location::Outside(_) => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constrained::cdt::face_key;
+    use crate::delaunay::Delaunay;
+
+    /// Two unit cubes side by side; the faces of the left cube are subfaces.
+    fn two_cubes() -> Cdt {
+        let mut pts = Vec::new();
+        for x in 0..3 {
+            for y in 0..2 {
+                for z in 0..2 {
+                    pts.push([x as f64, y as f64, z as f64]);
+                }
+            }
+        }
+        let mut cdt = Cdt::new(Delaunay::build(&pts).unwrap().dt);
+        // Subfaces: every face of the mesh lying on the boundary of the left cube [0,1]^3.
+        let p = cdt.dt.points.clone();
+        let on_left_boundary = |f: [u32; 3]| {
+            let q = f.map(|v| p[v as usize]);
+            (0..3).any(|k| {
+                (q.iter().all(|x| x[k] == 0.0) || q.iter().all(|x| x[k] == 1.0))
+                    && q.iter().all(|x| x[0] <= 1.0)
+            })
+        };
+        let tets: Vec<_> = cdt.dt.mesh.real_tets().collect();
+        for t in tets {
+            for i in 0..4 {
+                let f = cdt.dt.mesh.face_verts(t, i);
+                if on_left_boundary(f) {
+                    cdt.subfaces.insert(face_key(f), 0);
+                }
+            }
+        }
+        cdt
+    }
+
+    fn volume(cdt: &Cdt, tets: &[TetId]) -> f64 {
+        tets.iter()
+            .map(|&t| {
+                let v = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
+                crate::geom::orient3d(&v[0], &v[1], &v[2], &v[3]) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn the_exterior_is_removed_up_to_subfaces() {
+        let mut cdt = two_cubes();
+        let c = carve(&mut cdt, &[], &[], false);
+        assert!((volume(&cdt, &c.tets) - 1.0).abs() < 1e-12);
+        // Every kept tet lies in the left cube.
+        for &t in &c.tets {
+            assert!(cdt
+                .dt
+                .mesh
+                .verts(t)
+                .iter()
+                .all(|&v| cdt.dt.points[v as usize][0] <= 1.0));
+        }
+    }
+
+    #[test]
+    fn holes_regions_and_the_kept_hull() {
+        let mut cdt = two_cubes();
+        let c = carve(&mut cdt, &[], &[], true);
+        assert!((volume(&cdt, &c.tets) - 2.0).abs() < 1e-12);
+        let c = carve(&mut cdt, &[[0.5, 0.5, 0.5]], &[], true);
+        assert!(
+            (volume(&cdt, &c.tets) - 1.0).abs() < 1e-12,
+            "the hole empties the left cube"
+        );
+        let region = |x: f64, a: f64| Region {
+            point: [x, 0.5, 0.5],
+            attribute: a,
+            max_volume: -1.0,
+        };
+        let c = carve(&mut cdt, &[], &[region(0.5, 7.0), region(1.5, -2.0)], true);
+        for (&t, &a) in c.tets.iter().zip(&c.attributes) {
+            let left = cdt
+                .dt
+                .mesh
+                .verts(t)
+                .iter()
+                .all(|&v| cdt.dt.points[v as usize][0] <= 1.0);
+            assert_eq!(a, if left { 7.0 } else { -2.0 });
+        }
+    }
+}
