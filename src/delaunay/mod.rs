@@ -100,7 +100,7 @@ impl Delaunay {
             bbox: [[0.0; 3]; 2],
             filter: StaticFilter::new(&[0.0; 3], &[0.0; 3]),
         };
-        dt.set_bbox(bounding_box(&dt.points));
+        dt.set_bbox(crate::geom::bounding_box(&dt.points));
         // A DT of n random points has about 6.5 n tets; reserve to avoid regrowth.
         let expected = n * 7 + 16;
         dt.mesh.reserve(expected);
@@ -553,19 +553,6 @@ impl EdgeTable {
             h = (h + 1) & mask;
         }
     }
-}
-
-/// The smallest box holding `points` (an empty box for no points).
-fn bounding_box(points: &[Point]) -> [Point; 2] {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    [lo, hi]
 }
 
 /// Exact collinearity: all three axis-aligned projections have zero area.

@@ -95,14 +95,7 @@ pub fn insertion_order(points: &[Point]) -> InsertionOrder {
     if n == 0 {
         return InsertionOrder::default();
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let [lo, hi] = super::bounding_box(points);
     // Halved, so that the extent of coordinates near ±f64::MAX does not overflow.
     let span = (0..3)
         .map(|k| hi[k] * 0.5 - lo[k] * 0.5)

@@ -111,21 +111,7 @@ pub fn insphere(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
     let (bex, bey, bez) = (b[0] - e[0], b[1] - e[1], b[2] - e[2]);
     let (cex, cey, cez) = (c_[0] - e[0], c_[1] - e[1], c_[2] - e[2]);
     let (dex, dey, dez) = (d[0] - e[0], d[1] - e[1], d[2] - e[2]);
-    let ab = aex * bey - bex * aey;
-    let bc = bex * cey - cex * bey;
-    let cd = cex * dey - dex * cey;
-    let da = dex * aey - aex * dey;
-    let ac = aex * cey - cex * aey;
-    let bd = bex * dey - dex * bey;
-    let abc = aez * bc - bez * ac + cez * ab;
-    let bcd = bez * cd - cez * bd + dez * bc;
-    let cda = cez * da + dez * ac + aez * cd;
-    let dab = dez * ab + aez * bd + bez * da;
-    let alift = aex * aex + aey * aey + aez * aez;
-    let blift = bex * bex + bey * bey + bez * bez;
-    let clift = cex * cex + cey * cey + cez * cez;
-    let dlift = dex * dex + dey * dey + dez * dez;
-    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    let det = insphere_det(a, b, c_, d, e);
     // Semi-static filter: Shewchuk's first-stage bound (16ε times the permanent), with
     // the permanent bounded by 4 · (mx² + my² + mz²) · 6·mx·my·mz.
     let mx = max2(max2(aex.abs(), bex.abs()), max2(cex.abs(), dex.abs()));
