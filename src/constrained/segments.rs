@@ -196,8 +196,7 @@ impl Recovered {
                 continue;
             };
             list.retain(|&i| self.pieces[i].is_some());
-            for k in 0..list.len() {
-                let i = list[k];
+            for &i in list.iter() {
                 let Some(pc) = self.pieces[i] else { continue };
                 let other = if pc.u == x { pc.v } else { pc.u };
                 // Each piece is seen from both ends; check it from the lower one.
