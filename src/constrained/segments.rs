@@ -300,8 +300,10 @@ fn split_parameter(
 /// The split point from the piece's reference point (Si & Gärtner): the neighbour of
 /// its end `u` that sees the piece under the widest angle from inside its diametral
 /// sphere, projected onto the segment. Both halves then leave that vertex on or outside
-/// their diametral spheres, so one split often suffices. The projection is kept away
-/// from the piece's ends so that no needlessly short edge appears.
+/// their diametral spheres, so one split often suffices. A projection close to an end
+/// would make a needlessly short edge: there the split goes on the sphere centred at
+/// that end through the reference point instead, which also leaves the reference point
+/// outside the short half's diametral sphere and no shorter than an edge already there.
 fn reference_split(
     dt: &Delaunay,
     pc: Piece,
@@ -318,6 +320,7 @@ fn reference_split(
     }
     dt.star(pc.u, scratch);
     let mut best: Option<(f64, f64)> = None; // (cosine of the angle, parameter)
+    let mut dist = (0.0, 0.0); // the reference point's distances to u and v
     for &t in scratch.iter() {
         for &x in &dt.mesh.verts(t) {
             if x == crate::mesh::GHOST || x == pc.u || x == pc.v {
@@ -336,12 +339,21 @@ fn reference_split(
             let s = (0..3).map(|k| (q[k] - pa[k]) * d[k]).sum::<f64>() / dd;
             if best.is_none_or(|(c, _)| cos < c) {
                 best = Some((cos, s));
+                dist = (ne, nf);
             }
         }
     }
     let (_, s) = best?;
     let w = pc.s1 - pc.s0;
-    Some(s.clamp(pc.s0 + 0.1 * w, pc.s1 - 0.1 * w))
+    let len = dd.sqrt();
+    let s = if s < pc.s0 + 0.1 * w {
+        pc.s0 + dist.0 / len
+    } else if s > pc.s1 - 0.1 * w {
+        pc.s1 - dist.1 / len
+    } else {
+        s
+    };
+    Some(s.clamp(pc.s0 + 0.01 * w, pc.s1 - 0.01 * w))
 }
 
 #[cfg(test)]
