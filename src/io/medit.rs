@@ -67,7 +67,6 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
     let mut ended = false;
     while let Some(line) = t.line() {
         let key = line.token(String::new)?;
-        let line_no = line.number();
         let is = |k: &str| key.eq_ignore_ascii_case(k);
         if is("End") {
             ended = true;
@@ -92,7 +91,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
                 return Err(t.error("a second Vertices section"));
             }
             have_vertices = true;
-            let n = count(&mut t, "Vertices")?;
+            let (n, line_no) = count(&mut t, "Vertices")?;
             if u32::try_from(n).is_err() {
                 return Err(t.error(format!("too many vertices: {n}")));
             }
@@ -120,7 +119,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
             } else {
                 ("quadrilateral", 4)
             };
-            let n = count(&mut t, key)?;
+            let (n, line_no) = count(&mut t, key)?;
             plc.facets.reserve(n.min(MAX_RESERVE));
             let nv = plc.points.len();
             for i in 0..n {
@@ -153,7 +152,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
                 });
             }
         } else if let Some(&(name, per)) = SKIPPED.iter().find(|(k, _)| is(k)) {
-            let n = count(&mut t, name)?;
+            let (n, line_no) = count(&mut t, name)?;
             for i in 0..n {
                 for k in 0..per {
                     let what = || {
@@ -182,10 +181,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
     Ok(plc)
 }
 
-/// Reads the entry count after a section keyword.
-fn count(t: &mut Tokens<'_>, section: &str) -> Result<usize, InputError> {
+/// Reads the entry count after a section keyword; returns it with its line.
+fn count(t: &mut Tokens<'_>, section: &str) -> Result<(usize, usize), InputError> {
     let what = || format!("the number of entries of {section}");
-    t.expect(what)?.count(what)
+    let line = t.expect(what)?;
+    Ok((line.count(what)?, line.number()))
 }
 
 #[cfg(test)]

@@ -172,7 +172,13 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Plc, InputError> {
         }
         Format::LittleEndian | Format::BigEndian => {
             let big = header.format == Format::BigEndian;
-            read_binary(&bytes[header.data_start..], header.data_start, big, &header, &mut model)?;
+            read_binary(
+                &bytes[header.data_start..],
+                header.data_start,
+                big,
+                &header,
+                &mut model,
+            )?;
         }
     }
     Ok(model.plc)
@@ -202,13 +208,19 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header, InputError> {
         let mut words = raw.split_ascii_whitespace();
         let Some(key) = words.next() else {
             if number == 1 {
-                return Err(err(1, "not a PLY file: the first line must be `ply`".into()));
+                return Err(err(
+                    1,
+                    "not a PLY file: the first line must be `ply`".into(),
+                ));
             }
             continue;
         };
         if number == 1 {
             if key != "ply" || words.next().is_some() {
-                return Err(err(1, "not a PLY file: the first line must be `ply`".into()));
+                return Err(err(
+                    1,
+                    "not a PLY file: the first line must be `ply`".into(),
+                ));
             }
             continue;
         }
@@ -261,9 +273,8 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header, InputError> {
                 };
                 let ty = |w: Option<&str>| -> Result<Scalar, InputError> {
                     let w = w.unwrap_or("");
-                    Scalar::from_name(w).ok_or_else(|| {
-                        err(number, format!("unknown property type `{w}`"))
-                    })
+                    Scalar::from_name(w)
+                        .ok_or_else(|| err(number, format!("unknown property type `{w}`")))
                 };
                 let first = words.next();
                 let prop = if first == Some("list") {
@@ -358,7 +369,10 @@ impl<'a> Model<'a> {
             }
         }
         let Some(num_vertices) = num_vertices else {
-            return Err(err(header.lines, "the header declares no `vertex` element".into()));
+            return Err(err(
+                header.lines,
+                "the header declares no `vertex` element".into(),
+            ));
         };
         Ok(Model {
             path,
@@ -373,7 +387,11 @@ impl<'a> Model<'a> {
 
     /// The roles of the properties of `e`.
     fn roles(e: &Element) -> Vec<Role> {
-        let corners = if e.name == "face" { corner_prop(e) } else { None };
+        let corners = if e.name == "face" {
+            corner_prop(e)
+        } else {
+            None
+        };
         e.props
             .iter()
             .enumerate()
@@ -414,18 +432,22 @@ fn corner_prop(e: &Element) -> Option<usize> {
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// Reads the ASCII data section: the tokens of each element in turn.
-fn read_ascii(t: &mut Tokens<'_>, header: &Header, model: &mut Model<'_>) -> Result<(), InputError> {
+fn read_ascii(
+    t: &mut Tokens<'_>,
+    header: &Header,
+    model: &mut Model<'_>,
+) -> Result<(), InputError> {
     for e in &header.elements {
         let roles = Model::roles(e);
         let is_vertex = e.name == "vertex";
         let is_face = e.name == "face";
         let mut record = 0usize;
         let value = |t: &mut Tokens<'_>, ty: Scalar, what: &dyn Fn() -> String| {
-            let line = t.expect(|| what())?;
+            let line = t.expect(what)?;
             if ty.is_float() {
-                line.float(|| what())
+                line.float(what)
             } else {
-                line.int(|| what()).map(|v| v as f64)
+                line.int(what).map(|v| v as f64)
             }
         };
         // Reserve no more than a lying header could cost us.
@@ -631,9 +653,19 @@ mod tests {
 
     #[test]
     fn ascii_skips_other_properties_and_elements() {
-        let text = format!("{HEAD}0 1 0 0\n1 2 0 0\n0 3 1 0\n0 4 0 1\n3 0 1 2 0.5\n3 0 1 2 9\n4 0 1 2 3 1e3\n");
+        let text = format!(
+            "{HEAD}0 1 0 0\n1 2 0 0\n0 3 1 0\n0 4 0 1\n3 0 1 2 0.5\n3 0 1 2 9\n4 0 1 2 3 1e3\n"
+        );
         let plc = parse(text.as_bytes(), p()).unwrap();
-        assert_eq!(plc.points, vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        assert_eq!(
+            plc.points,
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0]
+            ]
+        );
         assert_eq!(plc.facets.len(), 2);
         assert_eq!(plc.facets[0].polygons, vec![vec![0, 1, 2]]);
         assert_eq!(plc.facets[1].polygons, vec![vec![0, 1, 2, 3]]);
@@ -647,7 +679,14 @@ mod tests {
         for &(t, v) in vals {
             macro_rules! put {
                 ($x:expr) => {
-                    b.extend(if big { $x.to_be_bytes() } else { $x.to_le_bytes() }.iter())
+                    b.extend(
+                        if big {
+                            $x.to_be_bytes()
+                        } else {
+                            $x.to_le_bytes()
+                        }
+                        .iter(),
+                    )
                 };
             }
             match t {
@@ -666,16 +705,35 @@ mod tests {
 
     fn binary_file(big: bool, z: f64, corner: f64) -> Vec<u8> {
         use Scalar::*;
-        let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let fmt = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
         let head = HEAD.replace("format ascii", &format!("format {fmt}"));
         let mut b = head.into_bytes();
         let mut vals = Vec::new();
-        for (i, pt) in [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, z]].iter().enumerate() {
+        for (i, pt) in [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, z],
+        ]
+        .iter()
+        .enumerate()
+        {
             vals.extend([(F32, pt[0]), (U8, i as f64), (F64, pt[1]), (I32, pt[2])]);
         }
         vals.extend([(U8, 3.0), (I32, 0.0), (I32, 1.0), (I32, 2.0), (F32, 0.5)]);
         vals.extend([(U8, 3.0), (U32, 0.0), (U32, 1.0), (U32, corner), (F32, 9.0)]);
-        vals.extend([(U8, 4.0), (U32, 0.0), (U32, 1.0), (U32, 2.0), (U32, 3.0), (F32, 1e3)]);
+        vals.extend([
+            (U8, 4.0),
+            (U32, 0.0),
+            (U32, 1.0),
+            (U32, 2.0),
+            (U32, 3.0),
+            (F32, 1e3),
+        ]);
         b.extend(bin(&vals, big));
         b
     }
@@ -694,14 +752,21 @@ mod tests {
         let err = |b: &[u8]| parse(b, p()).unwrap_err().to_string();
         let mut b = binary_file(false, 1.0, 2.0);
         b.truncate(b.len() - 3);
-        assert!(err(&b).starts_with("t.ply: the file ends inside face 1 (at byte offset "), "{}", err(&b));
+        assert!(
+            err(&b).starts_with("t.ply: the file ends inside face 1 (at byte offset "),
+            "{}",
+            err(&b)
+        );
         assert!(err(&binary_file(true, 1.0, 7.0)).starts_with(
             "t.ply: face 0 has corner 7, but there are only 4 vertices (numbered from 0) (at byte offset"
         ));
         let mut b = binary_file(false, 1.0, 2.0);
         b.push(0);
         assert!(err(&b).starts_with("t.ply: 1 bytes after the last element"));
-        assert_eq!(err(b"plyx\n"), "t.ply:1: not a PLY file: the first line must be `ply`");
+        assert_eq!(
+            err(b"plyx\n"),
+            "t.ply:1: not a PLY file: the first line must be `ply`"
+        );
         assert_eq!(
             err(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n"),
             "t.ply:3: the `vertex` element has no `z` property"
@@ -731,6 +796,10 @@ mod tests {
         );
         // A lying count allocates nothing.
         let b = b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
-        assert!(err(b).contains("announces 4000000000 `vertex` elements"), "{}", err(b));
+        assert!(
+            err(b).contains("announces 4000000000 `vertex` elements"),
+            "{}",
+            err(b)
+        );
     }
 }

@@ -201,10 +201,7 @@ fn keyword(t: &mut Tokens<'_>, word: &str, context: &dyn Fn() -> String) -> Resu
     if tok.eq_ignore_ascii_case(word) {
         Ok(())
     } else {
-        Err(line.error(format!(
-            "expected `{word}` in {}, found `{tok}`",
-            context()
-        )))
+        Err(line.error(format!("expected `{word}` in {}, found `{tok}`", context())))
     }
 }
 
@@ -223,7 +220,11 @@ fn parse_ascii(text: &str, path: &Path) -> Result<Plc, InputError> {
         };
         let tok = line.token(String::new)?;
         if !tok.eq_ignore_ascii_case("solid") {
-            let what = if solids == 0 { "`solid`" } else { "`solid` or the end of the file" };
+            let what = if solids == 0 {
+                "`solid`"
+            } else {
+                "`solid` or the end of the file"
+            };
             return Err(line.error(format!("expected {what}, found `{tok}`")));
         }
         solids += 1;
@@ -278,9 +279,9 @@ fn parse_ascii(text: &str, path: &Path) -> Result<Plc, InputError> {
                 )));
             }
             if !tok.eq_ignore_ascii_case("endloop") {
-                return Err(line.error(format!(
-                    "expected `endloop` in triangle {f}, found `{tok}`"
-                )));
+                return Err(
+                    line.error(format!("expected `endloop` in triangle {f}, found `{tok}`"))
+                );
             }
             keyword(&mut t, "endfacet", &ctx)?;
             facets.push(Facet {
@@ -331,7 +332,10 @@ mod tests {
         assert_eq!(w.weld([-0.0, 0.0, 1.0]), Some(0));
         assert_eq!(w.weld([1.0, 0.0, 0.0]), Some(1));
         // One ulp away is another point.
-        assert_eq!(w.weld([f64::from_bits(1.0f64.to_bits() + 1), 0.0, 0.0]), Some(2));
+        assert_eq!(
+            w.weld([f64::from_bits(1.0f64.to_bits() + 1), 0.0, 0.0]),
+            Some(2)
+        );
         assert_eq!(w.points.len(), 3);
         assert_eq!(w.points[0], [0.0, 0.0, 1.0]);
     }
@@ -384,7 +388,10 @@ mod tests {
         // A lying count allocates nothing.
         let mut b = binary("", &TRIS);
         b[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
-        assert!(parse(&b, p()).unwrap_err().to_string().contains("4294967295 triangles"));
+        assert!(parse(&b, p())
+            .unwrap_err()
+            .to_string()
+            .contains("4294967295 triangles"));
     }
 
     #[test]
@@ -392,7 +399,9 @@ mod tests {
         let err = |s: &str| parse(s.as_bytes(), p()).unwrap_err().to_string();
         let head = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n";
         assert_eq!(
-            err(&format!("{head}vertex 0 nan 0\nendloop\nendfacet\nendsolid\n")),
+            err(&format!(
+                "{head}vertex 0 nan 0\nendloop\nendfacet\nendsolid\n"
+            )),
             "t.stl:6: the y coordinate of corner 2 of triangle 0 is not a finite number: `nan`"
         );
         assert_eq!(

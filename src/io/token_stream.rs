@@ -83,11 +83,22 @@ mod tests {
         assert_eq!(t.peek(), Some("Vertices"));
         assert_eq!(t.line_number(), 1);
         t.skip_rest_of_line();
-        assert_eq!(t.expect(|| "n".into()).unwrap().count(|| "n".into()).unwrap(), 2);
+        assert_eq!(
+            t.expect(|| "n".into())
+                .unwrap()
+                .count(|| "n".into())
+                .unwrap(),
+            2
+        );
         assert_eq!(t.line_number(), 3);
         let mut v = Vec::new();
         for _ in 0..3 {
-            v.push(t.expect(|| "v".into()).unwrap().float(|| "v".into()).unwrap());
+            v.push(
+                t.expect(|| "v".into())
+                    .unwrap()
+                    .float(|| "v".into())
+                    .unwrap(),
+            );
         }
         assert_eq!(v, [1.0, 2.0, 3.0]);
         assert_eq!(t.line_number(), 5);
@@ -98,7 +109,14 @@ mod tests {
         assert_eq!(e, "t.mesh:5: unexpected end of file: expected vertex 3");
         let mut t = Tokens::new("1 x\n", p);
         t.expect(|| "a".into()).unwrap().int(|| "a".into()).unwrap();
-        let e = t.expect(|| "b".into()).unwrap().int(|| "b".into()).unwrap_err();
-        assert_eq!(e.to_string(), "t.mesh:1: expected b (an integer), found `x`");
+        let e = t
+            .expect(|| "b".into())
+            .unwrap()
+            .int(|| "b".into())
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.mesh:1: expected b (an integer), found `x`"
+        );
     }
 }

@@ -25,7 +25,13 @@ fn push_float(s: &mut String, buf: &mut ryu::Buffer, x: f64) {
         s.push_str(t.strip_suffix(".0").unwrap_or(t));
     } else {
         // Finite input gives finite nodes; this keeps a bug visible rather than hidden.
-        s.push_str(if x.is_nan() { "nan" } else if x > 0.0 { "inf" } else { "-inf" });
+        s.push_str(if x.is_nan() {
+            "nan"
+        } else if x > 0.0 {
+            "inf"
+        } else {
+            "-inf"
+        });
     }
 }
 
