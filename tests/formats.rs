@@ -392,6 +392,18 @@ fn check_medit(prefix: &Path, out: &Out, plc: bool) {
         );
     }
     assert_eq!(mesh[at + 2 + m..], [vec!["End"]]);
+    // Our own reader takes it back: the nodes, and the triangles as facets.
+    let back = read_plc(&with_ext(prefix, "mesh")).unwrap();
+    assert_eq!(back.points, out.nodes);
+    let facets: Vec<([i64; 3], i64)> = back
+        .facets
+        .iter()
+        .map(|f| {
+            let p = &f.polygons[0];
+            ([p[0], p[1], p[2]].map(i64::from), i64::from(f.marker))
+        })
+        .collect();
+    assert_eq!(facets, tris);
 }
 
 #[test]

@@ -135,11 +135,47 @@ fn too_many(path: &Path) -> InputError {
     }
 }
 
+/// For a file taken as binary although it begins with `solid`: where it stops being
+/// text, so that a damaged ASCII file is not only reported as a bad binary one.
+fn ascii_hint(bytes: &[u8]) -> String {
+    let start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+        .unwrap_or(0);
+    if !bytes[start..]
+        .get(..5)
+        .is_some_and(|k| k.eq_ignore_ascii_case(b"solid"))
+    {
+        return String::new();
+    }
+    let text = |b: u8| matches!(b, b'\t' | b'\n' | b'\r' | 0x0c | b' '..=b'~');
+    let first_end = bytes[start..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .map_or(bytes.len(), |i| start + i);
+    let bad = bytes[start..first_end]
+        .iter()
+        .position(|&b| b == 0)
+        .map(|i| start + i)
+        .or_else(|| {
+            bytes[first_end..]
+                .iter()
+                .position(|&b| !text(b))
+                .map(|i| first_end + i)
+        });
+    match bad {
+        Some(i) => format!(
+            " (the file begins with `solid` like an ASCII STL, but byte {i} is not text, so it was read as binary)"
+        ),
+        None => String::new(),
+    }
+}
+
 /// Parses a binary STL file (its size already checked or to be checked here).
 fn parse_binary(bytes: &[u8], path: &Path) -> Result<Plc, InputError> {
     let invalid = |msg: String| InputError::Invalid {
         file: path.to_path_buf(),
-        msg,
+        msg: msg + &ascii_hint(bytes),
     };
     let Some(n) = binary_count(bytes) else {
         return Err(invalid(format!(
@@ -373,8 +409,21 @@ mod tests {
         b.extend([0u8; 3]);
         assert_eq!(
             parse(&b, p()).unwrap_err().to_string(),
+            "t.stl: binary STL has 187 bytes, but the header announces 2 triangles (184 bytes) \
+             (the file begins with `solid` like an ASCII STL, but byte 81 is not text, so it was read as binary)"
+        );
+        let mut b = binary("x", &TRIS);
+        b.extend([0u8; 3]);
+        assert_eq!(
+            parse(&b, p()).unwrap_err().to_string(),
             "t.stl: binary STL has 187 bytes, but the header announces 2 triangles (184 bytes)"
         );
+        // An ASCII file damaged by a NUL byte.
+        let text = b"solid t\nfacet normal 0 0 1\nouter loop\0\n";
+        assert!(parse(text, p())
+            .unwrap_err()
+            .to_string()
+            .ends_with("but byte 37 is not text, so it was read as binary)"));
         let mut tris = TRIS;
         tris[1][2][1] = f32::INFINITY;
         assert_eq!(
