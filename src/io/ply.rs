@@ -74,6 +74,34 @@ impl Scalar {
         matches!(self, Scalar::F32 | Scalar::F64)
     }
 
+    /// The PLY name of the type.
+    fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
+    /// Whether an integer fits the type (floats take any value).
+    fn holds(self, v: i64) -> bool {
+        let (lo, hi) = match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into()),
+            Scalar::U8 => (0, u8::MAX.into()),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into()),
+            Scalar::U16 => (0, u16::MAX.into()),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into()),
+            Scalar::U32 => (0, u32::MAX.into()),
+            Scalar::F32 | Scalar::F64 => return true,
+        };
+        (lo..=hi).contains(&v)
+    }
+
     /// Decodes one value from exactly `size()` bytes.
     fn decode(self, b: &[u8], big: bool) -> f64 {
         macro_rules! num {
@@ -441,14 +469,20 @@ fn read_ascii(
         let roles = Model::roles(e);
         let is_vertex = e.name == "vertex";
         let is_face = e.name == "face";
-        let mut record = 0usize;
         let value = |t: &mut Tokens<'_>, ty: Scalar, what: &dyn Fn() -> String| {
             let line = t.expect(what)?;
             if ty.is_float() {
-                line.float(what)
-            } else {
-                line.int(what).map(|v| v as f64)
+                return line.float(what);
             }
+            let v = line.int(what)?;
+            if !ty.holds(v) {
+                return Err(line.error(format!(
+                    "{} is out of range for its type {}: {v}",
+                    what(),
+                    ty.name()
+                )));
+            }
+            Ok(v as f64)
         };
         // Reserve no more than a lying header could cost us.
         let cap = e.count.min(1 << 16);
@@ -457,8 +491,7 @@ fn read_ascii(
         } else if is_face {
             model.plc.facets.reserve(cap);
         }
-        while record < e.count {
-            let i = record;
+        for i in 0..e.count {
             let name = &e.name;
             let mut p = [0.0; 3];
             let mut polygon = Vec::new();
@@ -484,8 +517,10 @@ fn read_ascii(
                                 "the length of list `{pname}` of {name} {i} is negative: {n}"
                             )));
                         }
-                        line = t.line_number();
                         let corners = matches!(role, Role::Corners);
+                        if corners {
+                            line = t.line_number();
+                        }
                         if corners && n == 0.0 {
                             return Err(t.error(format!("face {i} has no corners")));
                         }
@@ -508,7 +543,6 @@ fn read_ascii(
                     ..Default::default()
                 });
             }
-            record += 1;
         }
     }
     Ok(())
@@ -778,6 +812,11 @@ mod tests {
         assert_eq!(
             err(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
             "t.ply:4: unexpected end of file: expected `end_header`"
+        );
+        let text = format!("{HEAD}0 1 0 0\n1 256 0 0\n");
+        assert_eq!(
+            err(text.as_bytes()),
+            "t.ply:17: property `red` of vertex 1 is out of range for its type uchar: 256"
         );
         let text = format!("{HEAD}0 1 0 0\n1 2 0 0\n0 3 1 0\n0 4 inf 1\n");
         assert_eq!(
