@@ -504,9 +504,19 @@ fn read_ascii(
                             Role::Coord(k) => format!("the {} coordinate of vertex {i}", AXES[*k]),
                             _ => format!("property `{pname}` of {name} {i}"),
                         };
-                        let v = value(t, prop.value, &what)?;
                         if let Role::Coord(k) = role {
-                            p[*k] = v;
+                            p[*k] = value(t, prop.value, &what)?;
+                        } else if prop.value.is_float() {
+                            // Unused: any number will do, NaN included (say, an unknown normal).
+                            let line = t.expect(what)?;
+                            let tok = line.token(what)?;
+                            if tok.parse::<f64>().is_err() {
+                                return Err(
+                                    line.error(format!("expected {}, found `{tok}`", what()))
+                                );
+                            }
+                        } else {
+                            value(t, prop.value, &what)?;
                         }
                     }
                     Some(count_ty) => {
@@ -690,6 +700,15 @@ mod tests {
         let text = format!(
             "{HEAD}0 1 0 0\n1 2 0 0\n0 3 1 0\n0 4 0 1\n3 0 1 2 0.5\n3 0 1 2 9\n4 0 1 2 3 1e3\n"
         );
+        // NaN is refused in a coordinate, accepted in an unused float property.
+        let nan_y = text.replace("\n1 2 0 0\n", "\n1 2 nan 0\n");
+        let e = parse(nan_y.as_bytes(), p()).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "t.ply:17: the y coordinate of vertex 1 is not a finite number: `nan`"
+        );
+        let nan_w = text.replace("3 0 1 2 0.5", "3 0 1 2 nan");
+        assert_eq!(parse(nan_w.as_bytes(), p()).unwrap().facets.len(), 2);
         let plc = parse(text.as_bytes(), p()).unwrap();
         assert_eq!(
             plc.points,
