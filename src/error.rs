@@ -34,7 +34,7 @@ pub enum InputError {
         msg: String,
     },
     /// The file's extension names no format we read.
-    #[error("{}: unknown input format (expected .node, .poly, .smesh, .off or .obj)", file.display())]
+    #[error("{}: unknown input format (expected .node, .poly, .smesh, .off, .obj, .stl, .ply or .mesh)", file.display())]
     UnknownFormat {
         /// The file concerned.
         file: PathBuf,

@@ -19,7 +19,7 @@ use tetcdt::options::Options;
 /// The switches, for `--help`.
 const SWITCHES: &str = "\
 Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
-  -p     Tetrahedralize a piecewise linear complex (.poly, .smesh, .off, .obj) [not implemented yet]
+  -p     Tetrahedralize a piecewise linear complex (.poly, .smesh, .off, .obj, .stl, .ply, .mesh) [not implemented yet]
   -C     Recover facets by cavity retriangulation (the default; needs -p)
   -F     Recover facets by flips (needs -p)
   -z     Number all output items from zero
@@ -27,14 +27,16 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -n     Write the neighbours of each tet to the .neigh file
   -f     Write all faces (not only boundary faces) to the .face file
   -I     No iteration number in output names (cube.node, not cube.1.node)
+  -k     Also write the mesh as legacy VTK: <prefix>.vtk (region attribute as CELL_DATA)
+  -g     Also write the mesh as Medit: <prefix>.mesh (subfaces as Triangles, tets with region ref)
   -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
   -Q     Quiet: no terminal output except errors
   -V     Verbose: print statistics (-VV for more)
-Other TetGen switches (-q, -a, -A, -r, -Y, -T, -S, -o2, -g, -k, ...) are recognised and refused.
+Other TetGen switches (-q, -a, -A, -r, -Y, -T, -S, -o2, -G, -K, ...) are recognised and refused.
 
 Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
 
-Output: <dir>/<base>.1.node, .ele, .face (and .edge, .neigh) next to the input; an input
+Output: <dir>/<base>.1.node, .ele, .face (and .edge, .neigh, .vtk, .mesh) next to the input; an input
 named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically.
 
 Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
@@ -63,7 +65,7 @@ struct Cli {
     /// Print the version.
     #[arg(long, action = ArgAction::Version)]
     version: Option<bool>,
-    /// The input model: a .node, .poly, .smesh, .off or .obj file.
+    /// The input model: a .node, .poly, .smesh, .off, .obj, .stl, .ply or .mesh file.
     #[arg(value_name = "FILE")]
     file: PathBuf,
 }

@@ -65,6 +65,10 @@ pub struct Options {
     pub region_attributes: bool,
     /// `-S`: the most Steiner points to add (`-S` alone or `-S0` means no limit).
     pub max_steiner: Option<usize>,
+    /// `-k`: also write the mesh as a legacy VTK `.vtk` file.
+    pub vtk_output: bool,
+    /// `-g`: also write the mesh as a Medit `.mesh` file.
+    pub medit_output: bool,
 }
 
 /// One thing wrong with the switches.
@@ -196,9 +200,7 @@ const REFUSED: &[(char, Arg, &str)] = &[
     ('B', Arg::None, "no boundary information in the output"),
     ('N', Arg::None, "no .node output"),
     ('E', Arg::None, "no .ele output"),
-    ('g', Arg::None, "Medit .mesh output"),
     ('G', Arg::None, "GiD .msh output"),
-    ('k', Arg::None, "VTK output"),
     ('K', Arg::None, "VTK output with extras"),
     ('v', Arg::None, "Voronoi diagram output"),
     ('u', Arg::None, "random point insertion order"),
@@ -296,6 +298,14 @@ impl Options {
                 }
                 'I' => {
                     self.no_iteration = true;
+                    true
+                }
+                'k' => {
+                    self.vtk_output = true;
+                    true
+                }
+                'g' => {
+                    self.medit_output = true;
                     true
                 }
                 'C' => {
@@ -528,6 +538,14 @@ mod tests {
             (&["-VVV"], Options { verbose: 3, ..d() }),
             (&["-V", "-V"], Options { verbose: 2, ..d() }),
             (
+                &["-kg"],
+                Options {
+                    vtk_output: true,
+                    medit_output: true,
+                    ..d()
+                },
+            ),
+            (
                 &["-z"],
                 Options {
                     zero_based: true,
@@ -639,8 +657,9 @@ mod tests {
             (&["-m"], &["-m (mesh sizing"]),
             (&["-i"], &["-i (insert"]),
             (&["-o2"], &["-o2 (second-order"]),
-            (&["-g"], &["-g (Medit"]),
-            (&["-k"], &["-k (VTK"]),
+            (&["-K"], &["-K (VTK output with extras"]),
+            (&["-G"], &["-G (GiD"]),
+            (&["-k1"], &["-k does not take the argument \"1\""]),
             (&["-J"], &["-J (no jettisoning"]),
             (&["-B"], &["-B (no boundary"]),
             (&["-N"], &["-N (no .node"]),
@@ -694,7 +713,7 @@ mod tests {
             ("-pq1.2a0.5", &["-q1.2 (", "-a0.5 ("]),
             ("-q1.2/15zy", &["-q1.2/15 (", "unknown switch -y"]),
             ("-q1.2e", &["-q1.2 ("]),
-            ("-a.5T1e+3S10k", &["-a.5 (", "-T1e+3 (", "-k ("]),
+            ("-a.5T1e+3S10K", &["-a.5 (", "-T1e+3 (", "-K ("]),
             ("-O2/7Vq", &["-O2/7 (", "-q ("]),
         ];
         for (s, wants) in table {

@@ -1,12 +1,17 @@
 //! Readers of TetGen's input formats and writers of its output files.
 
+pub mod medit;
 pub mod node;
 pub mod obj;
 pub mod off;
+pub mod ply;
 pub mod poly;
 pub mod smesh;
+pub mod stl;
+pub mod token_stream;
 pub mod tokens;
 pub mod write;
+pub mod write_extra;
 
 use crate::error::InputError;
 use crate::plc::Plc;
@@ -25,6 +30,13 @@ pub fn read_plc(path: &Path) -> Result<Plc, InputError> {
         "smesh" => smesh::read(path),
         "off" => off::read(path),
         "obj" => obj::read(path),
+        "stl" => stl::read(path),
+        "ply" => ply::read(path),
+        "mesh" => medit::read(path),
+        "meshb" => Err(InputError::Invalid {
+            file: path.to_path_buf(),
+            msg: "binary Medit files (.meshb) are not supported; convert to ASCII .mesh".into(),
+        }),
         _ => Err(InputError::UnknownFormat {
             file: path.to_path_buf(),
         }),

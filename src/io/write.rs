@@ -56,6 +56,10 @@ pub enum FileKind {
     Edge,
     /// `.neigh`: the neighbours of each tet.
     Neigh,
+    /// `.vtk`: legacy VTK unstructured grid (`-k`, see `write_extra`).
+    Vtk,
+    /// `.mesh`: Medit mesh (`-g`, see `write_extra`).
+    Medit,
 }
 
 impl FileKind {
@@ -67,6 +71,8 @@ impl FileKind {
             FileKind::Face => "face",
             FileKind::Edge => "edge",
             FileKind::Neigh => "neigh",
+            FileKind::Vtk => "vtk",
+            FileKind::Medit => "mesh",
         }
     }
 }
@@ -84,6 +90,10 @@ pub struct WriteOptions {
     pub all_faces: bool,
     /// Text of the comment line ending every file (`# <comment>`), if any.
     pub comment: Option<String>,
+    /// Write a legacy VTK `.vtk` file (`-k`).
+    pub vtk: bool,
+    /// Write a Medit `.mesh` file (`-g`).
+    pub medit: bool,
 }
 
 impl WriteOptions {
@@ -95,6 +105,8 @@ impl WriteOptions {
             write_neighbors: opts.write_neighbors,
             all_faces: opts.all_faces,
             comment: None,
+            vtk: opts.vtk_output,
+            medit: opts.medit_output,
         }
     }
 
@@ -109,7 +121,8 @@ impl WriteOptions {
 }
 
 /// The files a run writes, in the order they are written: `.node`, `.ele`, `.face`,
-/// then `.edge` (with `-e`, and always for a PLC) and `.neigh` (with `-n`).
+/// then `.edge` (with `-e`, and always for a PLC), `.neigh` (with `-n`), `.vtk` (with
+/// `-k`) and `.mesh` (with `-g`).
 pub fn file_kinds(plc_mode: bool, w: &WriteOptions) -> Vec<FileKind> {
     let mut kinds = vec![FileKind::Node, FileKind::Ele, FileKind::Face];
     if w.write_edges || plc_mode {
@@ -117,6 +130,12 @@ pub fn file_kinds(plc_mode: bool, w: &WriteOptions) -> Vec<FileKind> {
     }
     if w.write_neighbors {
         kinds.push(FileKind::Neigh);
+    }
+    if w.vtk {
+        kinds.push(FileKind::Vtk);
+    }
+    if w.medit {
+        kinds.push(FileKind::Medit);
     }
     kinds
 }
@@ -387,6 +406,8 @@ fn write_kind_with<'a, W: Write>(
         FileKind::Face => write_face(out, mesh, w, d()),
         FileKind::Edge => write_edge(out, mesh, w, d()),
         FileKind::Neigh => write_neigh(out, mesh, w, d()),
+        FileKind::Vtk => super::write_extra::write_vtk(out, mesh, w),
+        FileKind::Medit => super::write_extra::write_medit(out, mesh, w, d()),
     }
 }
 
