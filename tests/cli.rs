@@ -100,7 +100,10 @@ fn usage_errors_exit_2_naming_the_switch() {
         ),
         (&[], "required arguments were not provided"),
         (&["-zQ"], "required arguments were not provided"),
-        (&["p.node", "q.node"], "unexpected argument 'q.node'"),
+        (
+            &["p.node", "q.node", "-o", "x"],
+            "-o/--output names the outputs of a single input, but 2 inputs were given",
+        ),
         (&["--bogus", "p.node"], "unexpected argument '--bogus'"),
         (
             &["p.node", "-o"],

@@ -214,7 +214,7 @@ mod tests {
         let t = table(&rows);
         let lines: Vec<&str> = t.lines().collect();
         assert_eq!(lines.len(), 4, "{t}");
-        assert!(lines[0].starts_with("model       status"), "{t}");
+        assert!(lines[0].starts_with("model        status"), "{t}");
         assert!(lines[1].starts_with("a/cube.poly  ok"), "{t}");
         assert!(lines[1].ends_with("9        0     6    0.250"), "{t}");
         assert!(
@@ -264,7 +264,7 @@ mod tests {
             "{bad}"
         );
         assert!(
-            bad.contains("\\tvertex 9 is not a vertex\\nmore\"}"),
+            bad.contains("\\u0009vertex 9 is not a vertex\\u000amore\"}"),
             "{bad}"
         );
     }
