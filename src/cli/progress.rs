@@ -47,7 +47,10 @@ impl Bars {
         // Hidden at first: the reveal thread switches to stderr once the work is slow.
         let multi = MultiProgress::with_draw_target(ProgressDrawTarget::hidden());
         let overall = (models > 1).then(|| {
-            let pb = multi.add(ProgressBar::new(models as u64));
+            let pb = multi.add(ProgressBar::with_draw_target(
+                Some(models as u64),
+                ProgressDrawTarget::hidden(),
+            ));
             pb.set_style(
                 ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} models, {elapsed}")
                     .unwrap_or_else(|_| ProgressStyle::default_bar())
@@ -78,7 +81,8 @@ impl Bars {
         let Some(live) = &self.live else {
             return ModelBar { bar: None };
         };
-        let pb = ProgressBar::new_spinner();
+        // Born hidden: a new bar would draw on stderr at once, before joining the group.
+        let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
         pb.set_style(
             ProgressStyle::with_template("{spinner} {prefix}: {msg} ({elapsed})")
                 .unwrap_or_else(|_| ProgressStyle::default_spinner()),
