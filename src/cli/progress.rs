@@ -16,6 +16,15 @@ use tetcdt::progress::Stage;
 /// How long the work must take before bars appear.
 pub const REVEAL_AFTER: Duration = Duration::from_millis(1000);
 
+/// [`REVEAL_AFTER`], unless `TETCDT_PROGRESS_DELAY_MS` says otherwise (tests use 0 to
+/// see bars on quick models).
+fn reveal_after() -> Duration {
+    std::env::var("TETCDT_PROGRESS_DELAY_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(REVEAL_AFTER, Duration::from_millis)
+}
+
 /// How often spinners move.
 const TICK: Duration = Duration::from_millis(120);
 
@@ -60,10 +69,11 @@ impl Bars {
             pb.enable_steady_tick(TICK);
             pb
         });
+        let delay = reveal_after();
         let (tx, rx) = mpsc::channel::<()>();
         let shown = multi.clone();
         let thread = std::thread::spawn(move || {
-            if let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(REVEAL_AFTER) {
+            if let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(delay) {
                 shown.set_draw_target(ProgressDrawTarget::stderr());
             }
         });
