@@ -248,8 +248,10 @@ mod tests {
         let (_, msg) = code_of(&["a.node", "a.1.node"], &opts).unwrap();
         assert_eq!(msg, "meshing a.node would overwrite the input a.1.node");
         // Own-input overwrites (-I) are the model's own usage error, not the batch's.
-        let mut opts = Options::default();
-        opts.no_iteration = true;
+        let opts = Options {
+            no_iteration: true,
+            ..Default::default()
+        };
         assert!(code_of(&["a.node", "b.node"], &opts).is_none());
     }
 
