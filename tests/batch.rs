@@ -529,3 +529,88 @@ fn progress_bars_only_on_a_terminal() {
     let ci = on_tty("-p", true);
     assert!(!ci.contains("\x1b["), "{ci:?}");
 }
+
+#[test]
+fn table1_script_tabulates_ours_beside_tetgen() {
+    if std::process::Command::new("python3")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        eprintln!("python3 is not installed: scripts/table1.py is not tested");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let models = dir.path().join("models");
+    fs::create_dir(&models).unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
+    fs::copy(data.join("plc/fig4_p.poly"), models.join("fig4_p.poly")).unwrap();
+    fs::copy(data.join("plc/sphere.off"), models.join("sphere.off")).unwrap();
+    fs::write(models.join("broken.off"), BROKEN).unwrap();
+    let md = dir.path().join("t.md");
+    let out = std::process::Command::new("python3")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/table1.py"))
+        .arg("--tetcdt")
+        .arg(assert_cmd::cargo::cargo_bin("tetcdt"))
+        .arg("--timeout")
+        .arg("60")
+        .arg("-o")
+        .arg(&md)
+        .arg(&models)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let text = fs::read_to_string(&md).unwrap();
+    let row = |label: &str| -> Vec<String> {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("| {label} |")))
+            .unwrap_or_else(|| panic!("no row {label}:\n{text}"));
+        line.trim_matches('|')
+            .split('|')
+            .map(|c| c.trim().to_string())
+            .collect()
+    };
+    // Columns: broken, fig4_p, sphere (sorted), each "ours" then "TetGen".
+    let head = row("row");
+    assert_eq!(
+        head[1..],
+        [
+            "broken ours",
+            "broken TetGen",
+            "fig4_p ours",
+            "fig4_p TetGen",
+            "sphere ours",
+            "sphere TetGen"
+        ]
+    );
+    let vertices = row("(1) input vertices");
+    assert_eq!(vertices[1], "fail 3", "{text}");
+    assert_eq!(vertices[3], "13");
+    assert_eq!(vertices[5], "162");
+    let tetgen = std::process::Command::new("tetgen")
+        .arg("-h")
+        .output()
+        .is_ok();
+    if tetgen {
+        assert_eq!(vertices[4], "13");
+        assert_eq!(vertices[6], "162");
+        // The sphere needs no Steiner points: both give the same tets.
+        let tets = row("(4) output tetrahedra");
+        assert_eq!(tets[5], tets[6], "{text}");
+    }
+    // Our flip column is filled once -F exists, marked "n/a" while it is refused.
+    let flips = row("(15) flip algorithm seconds");
+    assert!(
+        flips[3] == "n/a" || flips[3].parse::<f64>().is_ok(),
+        "{text}"
+    );
+    assert!(text.contains("## Table 2"), "{text}");
+    assert!(text.contains("| ours -p (cavity) | Delaunay |"), "{text}");
+    assert!(
+        text.contains("broken: `tetcdt -pQV`: MODEL:6: face 0 has corner 7"),
+        "{text}"
+    );
+    // Nothing is written beside the models.
+    assert_eq!(fs::read_dir(&models).unwrap().count(), 3);
+}
