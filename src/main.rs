@@ -1,10 +1,10 @@
-//! The `tetcdt` command: `tetcdt [-switches] FILE`, TetGen style.
+//! The `tetcdt` command: `tetcdt [-switches] FILE...`, TetGen style.
 //!
 //! Packed switch strings (`-zQ`, `-pq1.2`) are taken out of the arguments and parsed by
 //! [`tetcdt::options`]; clap handles the rest (`--help`, `--version`, `-o PREFIX`,
-//! `--check` and the input file). Errors are printed as `tetcdt: <error>` on stderr and
-//! exit with the codes of [`tetcdt::error`]: 0 ok, 1 meshing failed, 2 usage, 3 invalid
-//! input, 4 I/O.
+//! `--check`, the batch options and the input files). The work itself is in `cli`.
+//! Errors are printed as `tetcdt: <error>` on stderr and exit with the codes of
+//! [`tetcdt::error`]: 0 ok, 1 meshing failed, 2 usage, 3 invalid input, 4 I/O.
 
 mod cli;
 
@@ -71,15 +71,15 @@ struct Cli {
     /// (one line per model).
     #[arg(long = "stats-json", value_name = "FILE")]
     stats_json: Option<PathBuf>,
-    /// Print the version.
-    #[arg(long, action = ArgAction::Version)]
-    version: Option<bool>,
     /// Mesh this many models at once (default: the number of cores).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=4096))]
     jobs: Option<u64>,
     /// Write the summary (model, status, vertices, Steiner points, tets, seconds) as TSV.
     #[arg(long, value_name = "FILE")]
     summary: Option<PathBuf>,
+    /// Print the version.
+    #[arg(long, action = ArgAction::Version)]
+    version: Option<bool>,
     /// The input models: .node, .poly, .smesh, .off or .obj files.
     #[arg(value_name = "FILE", required = true, num_args = 1..)]
     files: Vec<PathBuf>,
