@@ -279,7 +279,7 @@ fn messages_come_whole_per_model_without_progress_bars() {
     assert!(!has_control(&stdout) && !has_control(&stderr), "{stderr:?}");
     // Errors name their model.
     assert!(
-        stderr.contains("tetcdt: open.off: invalid PLC: no tetrahedra remain"),
+        stderr.lines().any(|l| l.starts_with("tetcdt: open.off: ")),
         "{stderr}"
     );
     assert!(stderr.contains("tetcdt: broken.off:6: "), "{stderr}");
