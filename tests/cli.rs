@@ -763,3 +763,21 @@ fn stats_json_matches_the_written_mesh() {
         "{json}"
     );
 }
+
+#[test]
+fn an_open_surface_is_refused_before_meshing_naming_its_rim() {
+    let dir = tempfile::tempdir().unwrap();
+    // A box without its top: nothing is enclosed.
+    let off = "OFF\n8 5 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n\
+               4 0 2 3 1\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
+    fs::write(dir.path().join("open.off"), off).unwrap();
+    let (code, _, err) = run_in(dir.path(), &["-pQ", "open.off"]);
+    assert_eq!(code, 3, "{err}");
+    assert!(err.contains("open and encloses no volume"), "{err}");
+    assert!(err.contains("4 boundary edge(s)"), "{err}");
+    assert!(err.contains("4-5 ([0.0, 0.0, 1.0] to [1.0, 0.0, 1.0])"), "{err}");
+    assert_eq!(listing(dir.path()), vec!["open.off"]);
+    // With -c the convex hull is meshed instead.
+    let (code, _, err) = run_in(dir.path(), &["-pcQ", "open.off"]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -8,6 +8,7 @@
 
 pub mod cavity;
 pub mod cdt;
+pub mod enclosure;
 pub mod facet2d;
 pub mod prepare;
 pub mod segments;
@@ -132,6 +133,11 @@ pub fn mesh_plc_with_progress(
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
     let mut prep = prepare(plc, opts.merge)?;
+    if !opts.keep_hull {
+        if let Some(rim) = enclosure::open_boundary(plc, &prep) {
+            return Err(MeshError::InvalidPlc(open_surface_message(plc, &rim)).into());
+        }
+    }
     // Input facets kept out of merging because their merged group could not be
     // triangulated in one plane.
     let mut keep_apart: Vec<usize> = Vec::new();
@@ -709,6 +715,32 @@ fn regions_of(
         out.push(region);
     }
     out
+}
+
+/// The refusal of a surface that encloses nothing, naming its first boundary edges.
+fn open_surface_message(plc: &Plc, rim: &[[u32; 2]]) -> String {
+    let shown: Vec<String> = rim
+        .iter()
+        .take(5)
+        .map(|&[a, b]| {
+            let p = |v: u32| plc.points[v as usize];
+            format!(
+                "{}-{} ({:?} to {:?})",
+                a as usize + plc.first_index,
+                b as usize + plc.first_index,
+                p(a),
+                p(b)
+            )
+        })
+        .collect();
+    format!(
+        "the surface is open and encloses no volume, so the meshed domain would be empty \
+         (-c keeps the convex hull instead): {} boundary edge(s) lie on only one facet, \
+         first: {}{}",
+        rim.len(),
+        shown.join(", "),
+        if rim.len() > shown.len() { ", ..." } else { "" }
+    )
 }
 
 /// Carves the mesh and puts it in output form.

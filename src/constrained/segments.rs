@@ -85,8 +85,11 @@ pub fn recover_segments(
             prev = (s, w);
         }
     }
-    let mut done: Vec<Piece> = Vec::with_capacity(segments.len());
+    // Recovered pieces, indexed by both endpoints: an insertion can only remove edges
+    // between vertices of its cavity, so only those pieces are checked again.
+    let mut done = Recovered::default();
     let mut scratch = Vec::new();
+    let mut cavity = Vec::new();
     loop {
         while let Some(pc) = queue.pop() {
             if dt.has_edge(pc.u, pc.v, &mut scratch) {
@@ -119,6 +122,8 @@ pub fn recover_segments(
             *next_pert += 1;
             steiner += 1;
             splits[pc.seg].push((s, w));
+            dt.last_cavity_vertices(&mut cavity);
+            done.recheck(dt, &cavity, w, &mut queue, &mut scratch);
             queue.push(Piece {
                 seg: pc.seg,
                 s0: pc.s0,
@@ -134,17 +139,8 @@ pub fn recover_segments(
                 v: pc.v,
             });
         }
-        // Later insertions can destroy subsegments recovered earlier; recheck them all.
-        let before = done.len();
-        let mut kept = Vec::with_capacity(before);
-        for pc in done.drain(..) {
-            if dt.has_edge(pc.u, pc.v, &mut scratch) {
-                kept.push(pc);
-            } else {
-                queue.push(pc);
-            }
-        }
-        done = kept;
+        // A last full check, in case a piece was lost without a recorded cavity.
+        done.recheck_all(dt, &mut queue, &mut scratch);
         if queue.is_empty() {
             break;
         }
@@ -165,6 +161,72 @@ pub fn recover_segments(
         chains,
         steiner_points: steiner,
     })
+}
+
+/// The pieces recovered so far, with the pieces at each vertex.
+#[derive(Default)]
+struct Recovered {
+    pieces: Vec<Option<Piece>>,
+    at: rustc_hash::FxHashMap<VertexId, Vec<usize>>,
+}
+
+impl Recovered {
+    fn push(&mut self, pc: Piece) {
+        let i = self.pieces.len();
+        self.pieces.push(Some(pc));
+        self.at.entry(pc.u).or_default().push(i);
+        self.at.entry(pc.v).or_default().push(i);
+    }
+
+    /// Sends back to `queue` the pieces between two `cavity` vertices that are no
+    /// longer edges (`new` is the vertex just inserted, which no recovered piece has).
+    fn recheck(
+        &mut self,
+        dt: &Delaunay,
+        cavity: &[VertexId],
+        new: VertexId,
+        queue: &mut Vec<Piece>,
+        scratch: &mut Vec<crate::mesh::TetId>,
+    ) {
+        for &x in cavity {
+            if x == new {
+                continue;
+            }
+            let Some(list) = self.at.get_mut(&x) else {
+                continue;
+            };
+            list.retain(|&i| self.pieces[i].is_some());
+            for &i in list.iter() {
+                let Some(pc) = self.pieces[i] else { continue };
+                let other = if pc.u == x { pc.v } else { pc.u };
+                // Each piece is seen from both ends; check it from the lower one.
+                if other < x && cavity.binary_search(&other).is_ok() {
+                    continue;
+                }
+                if cavity.binary_search(&other).is_ok() && !dt.has_edge(pc.u, pc.v, scratch) {
+                    self.pieces[i] = None;
+                    queue.push(pc);
+                }
+            }
+        }
+    }
+
+    /// Sends back to `queue` every piece that is no longer an edge.
+    fn recheck_all(
+        &mut self,
+        dt: &Delaunay,
+        queue: &mut Vec<Piece>,
+        scratch: &mut Vec<crate::mesh::TetId>,
+    ) {
+        for slot in &mut self.pieces {
+            if let Some(pc) = *slot {
+                if !dt.has_edge(pc.u, pc.v, scratch) {
+                    *slot = None;
+                    queue.push(pc);
+                }
+            }
+        }
+    }
 }
 
 /// Vertices where two segments meet at less than 90 degrees.
