@@ -70,9 +70,16 @@ impl Bars {
             pb
         });
         let delay = reveal_after();
+        if delay.is_zero() {
+            // No race with the reveal thread: shown from the first stage on.
+            multi.set_draw_target(ProgressDrawTarget::stderr());
+        }
         let (tx, rx) = mpsc::channel::<()>();
         let shown = multi.clone();
         let thread = std::thread::spawn(move || {
+            if delay.is_zero() {
+                return;
+            }
             if let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(delay) {
                 shown.set_draw_target(ProgressDrawTarget::stderr());
             }
