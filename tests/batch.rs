@@ -508,6 +508,7 @@ fn progress_bars_only_on_a_terminal() {
         );
         let mut c = std::process::Command::new("script");
         c.current_dir(d)
+            .stdin(std::process::Stdio::null())
             .env("TETCDT_PROGRESS_DELAY_MS", "0")
             .args(["-qec", &cmd, "/dev/null"]);
         if ci {
