@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod options;
 pub mod output;
 pub mod plc;
+pub mod progress;
 
 pub use error::{Error, InputError, MeshError};
 pub use options::Options;
@@ -40,7 +41,16 @@ pub struct Meshed {
 
 /// Meshes a model: the Delaunay tetrahedralization of its points (and, with `-p`, its CDT).
 pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
-    pipeline::run(plc, opts)
+    pipeline::run(plc, opts, &progress::no_progress)
+}
+
+/// Like [`tetrahedralize`], telling `progress` when each stage begins.
+pub fn tetrahedralize_with_progress(
+    plc: &Plc,
+    opts: &Options,
+    progress: progress::Progress<'_>,
+) -> Result<Meshed, Error> {
+    pipeline::run(plc, opts, progress)
 }
 
 mod pipeline;

@@ -1,25 +1,26 @@
-//! The `tetcdt` command: `tetcdt [-switches] FILE`, TetGen style.
+//! The `tetcdt` command: `tetcdt [-switches] FILE...`, TetGen style.
 //!
 //! Packed switch strings (`-zQ`, `-pq1.2`) are taken out of the arguments and parsed by
 //! [`tetcdt::options`]; clap handles the rest (`--help`, `--version`, `-o PREFIX`,
-//! `--check` and the input file). Errors are printed as `tetcdt: <error>` on stderr and
-//! exit with the codes of [`tetcdt::error`]: 0 ok, 1 meshing failed, 2 usage, 3 invalid
-//! input, 4 I/O.
+//! `--check`, the batch options and the input files). The work itself is in `cli`.
+//! Errors are printed as `tetcdt: <error>` on stderr and exit with the codes of
+//! [`tetcdt::error`]: 0 ok, 1 meshing failed, 2 usage, 3 invalid input, 4 I/O.
+
+mod cli;
 
 use anyhow::anyhow;
 use clap::{ArgAction, Parser};
 use std::ffi::OsString;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 use tetcdt::error::{EXIT_MESH_FAILED, EXIT_OK, EXIT_USAGE};
-use tetcdt::io::write::{self as writer, WriteOptions};
 use tetcdt::options::Options;
 
 /// The switches, for `--help`.
 const SWITCHES: &str = "\
 Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
-  -p     Tetrahedralize a piecewise linear complex (.poly, .smesh, .off, .obj, .stl, .ply, .mesh) [not implemented yet]
+  -p     Tetrahedralize a piecewise linear complex (.poly, .smesh, .off, .obj, .stl, .ply, .mesh)
   -C     Recover facets by cavity retriangulation (the default; needs -p)
   -F     Recover facets by flips (needs -p)
   -z     Number all output items from zero
@@ -27,20 +28,33 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -n     Write the neighbours of each tet to the .neigh file
   -f     Write all faces (not only boundary faces) to the .face file
   -I     No iteration number in output names (cube.node, not cube.1.node)
+  -c     Keep the convex hull: mesh the hull instead of carving the exterior (needs -p)
+  -A     Give each tet the attribute of its region from the region list (needs -p)
+  -M     Do not merge coplanar adjacent facets (needs -p)
+  -S[n]  At most n Steiner points (-S or -S0: no limit); reaching it is an error
   -k     Also write the mesh as legacy VTK: <prefix>.vtk (region attribute as CELL_DATA)
   -g     Also write the mesh as Medit: <prefix>.mesh (subfaces as Triangles, tets with region ref)
   -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
   -Q     Quiet: no terminal output except errors
   -V     Verbose: print statistics (-VV for more)
-Other TetGen switches (-q, -a, -A, -r, -Y, -T, -S, -o2, -G, -K, ...) are recognised and refused.
+Other TetGen switches (-q, -a, -r, -Y, -T, -o2, -G, -K, ...) are recognised and refused.
 
 Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
+
+Several FILEs are meshed in parallel (--jobs N, default: the number of cores), each
+with its own outputs; each model's messages are printed whole when it is done, errors
+prefixed with its name, then a summary table (model, status, vertices, Steiner points,
+tets, seconds) on stdout, also with -Q. --summary FILE writes it as TSV (also for one
+input); --stats-json FILE writes one JSON line per model. -o needs a single FILE.
+Progress bars appear on stderr when it is a terminal and a run takes over a second
+(never with -Q or when CI is set).
 
 Output: <dir>/<base>.1.node, .ele, .face (and .edge, .neigh, .vtk, .mesh) next to the input; an input
 named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically.
 
 Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
-3 invalid input, 4 I/O error.";
+3 invalid input, 4 I/O error. With several FILEs: the code of the first FILE (in
+command-line order) that failed; the others are meshed all the same.";
 
 /// The options clap sees; packed switch strings are removed beforehand.
 #[derive(Parser, Debug)]
@@ -48,7 +62,7 @@ Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
     name = "tetcdt",
     version,
     about = "Constrained Delaunay tetrahedralizations with exact predicates, TetGen-compatible files",
-    override_usage = "tetcdt [-switches] [-o PREFIX] [--check] FILE",
+    override_usage = "tetcdt [-switches] [options] FILE...",
     after_help = SWITCHES,
     disable_version_flag = true
 )]
@@ -59,15 +73,22 @@ struct Cli {
     /// Validate the mesh after writing it; exit 1 listing the problems if any.
     #[arg(long)]
     check: bool,
-    /// Write the run's statistics (with -p, the paper's Table 1 figures) as JSON to FILE.
+    /// Write the run's statistics (with -p, the paper's Table 1 figures) as JSON to FILE
+    /// (one line per model).
     #[arg(long = "stats-json", value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// Mesh this many models at once (default: the number of cores).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=4096))]
+    jobs: Option<u64>,
+    /// Write the summary (model, status, vertices, Steiner points, tets, seconds) as TSV.
+    #[arg(long, value_name = "FILE")]
+    summary: Option<PathBuf>,
     /// Print the version.
     #[arg(long, action = ArgAction::Version)]
     version: Option<bool>,
-    /// The input model: a .node, .poly, .smesh, .off, .obj, .stl, .ply or .mesh file.
-    #[arg(value_name = "FILE")]
-    file: PathBuf,
+    /// The input models: .node, .poly, .smesh, .off, .obj, .stl, .ply or .mesh files.
+    #[arg(value_name = "FILE", required = true, num_args = 1..)]
+    files: Vec<PathBuf>,
 }
 
 /// A failed run: the exit code and the error to print.
@@ -89,26 +110,6 @@ impl From<tetcdt::Error> for Failure {
     fn from(e: tetcdt::Error) -> Self {
         Failure::new(e.exit_code(), e)
     }
-}
-
-/// Progress messages on stdout, unless quiet; write errors (a closed pipe) are ignored.
-struct Say {
-    quiet: bool,
-}
-
-impl Say {
-    fn line(&self, msg: std::fmt::Arguments<'_>) {
-        if !self.quiet {
-            let mut out = std::io::stdout().lock();
-            let _ = out.write_fmt(msg);
-            let _ = out.write_all(b"\n");
-            let _ = out.flush();
-        }
-    }
-}
-
-macro_rules! say {
-    ($s:expr, $($arg:tt)*) => { $s.line(format_args!($($arg)*)) };
 }
 
 /// Splits the arguments (after the program name) into packed switch strings and the
@@ -149,9 +150,9 @@ fn split_args(args: &[OsString]) -> Result<(Vec<String>, Vec<OsString>), Failure
     Ok((switches, rest))
 }
 
-/// Parses the command line into options and the input file. `Ok(None)` means that
+/// Parses the command line into options and the input files. `Ok(None)` means that
 /// clap printed help or the version.
-fn parse_args(args: &[OsString]) -> Result<Option<(Options, PathBuf)>, Failure> {
+fn parse_args(args: &[OsString]) -> Result<Option<cli::Invocation>, Failure> {
     let (switches, rest) = split_args(args)?;
     let cli = match Cli::try_parse_from(std::iter::once(OsString::from("tetcdt")).chain(rest)) {
         Ok(cli) => cli,
@@ -175,123 +176,22 @@ fn parse_args(args: &[OsString]) -> Result<Option<(Options, PathBuf)>, Failure> 
     opts.output = cli.output;
     opts.check = cli.check;
     opts.stats_json = cli.stats_json;
-    Ok(Some((opts, cli.file)))
+    Ok(Some(cli::Invocation {
+        opts,
+        files: cli.files,
+        jobs: cli.jobs.map(|n| n as usize),
+        summary: cli.summary,
+        switches,
+    }))
 }
 
-/// Runs the command; returns the exit code of a successful or help run.
+/// Runs the command; returns the exit code of a finished or help run.
 fn run(args: Vec<OsString>) -> Result<i32, Failure> {
     let start = Instant::now();
-    let Some((opts, file)) = parse_args(&args)? else {
+    let Some(inv) = parse_args(&args)? else {
         return Ok(EXIT_OK);
     };
-    let say = Say { quiet: opts.quiet };
-
-    // Name the outputs first, so that a naming problem costs no meshing time.
-    let mut wopts = WriteOptions::from_options(&opts);
-    let prefix = writer::output_prefix(&file, opts.output.as_deref(), opts.no_iteration)
-        .map_err(|e| Failure::new(EXIT_USAGE, e))?;
-    let outputs: Vec<PathBuf> = writer::file_kinds(opts.plc, &wopts)
-        .into_iter()
-        .map(|k| writer::output_path(&prefix, k))
-        .collect();
-    writer::check_outputs_spare_input(&file, &outputs).map_err(|e| Failure::new(EXIT_USAGE, e))?;
-    writer::check_output_dir(&prefix)?;
-
-    say!(say, "Opening {}.", file.display());
-    let plc = tetcdt::io::read_plc(&file).map_err(tetcdt::Error::from)?;
-
-    if opts.plc {
-        say!(say, "Constrained Delaunay tetrahedralization...");
-    } else {
-        say!(say, "Delaunizing vertices...");
-    }
-    wopts.comment = Some(generated_by(&args));
-    // A point set's nodes are its input points: their file is written on the other core
-    // while the points are meshed (writing a million nodes takes a tenth of a second).
-    let nodes = writer::Nodes::of_plc(&plc);
-    let (meshed, early) = std::thread::scope(|s| {
-        let early =
-            (!opts.plc).then(|| s.spawn(|| writer::write_node_early(&nodes, &prefix, &wopts)));
-        let meshed = tetcdt::tetrahedralize(&plc, &opts);
-        let early = early.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
-        (meshed, early)
-    });
-    let meshed = meshed?;
-    let early = early.transpose()?;
-    say!(say, "Delaunay seconds:  {}", meshed.stats.delaunay_secs);
-    if !opts.quiet {
-        let mut err = std::io::stderr().lock();
-        for w in &meshed.warnings {
-            let _ = writeln!(err, "Warning: {w}");
-        }
-    }
-
-    let out_start = Instant::now();
-    say!(say, "");
-    writer::write_files_with(
-        &meshed.mesh,
-        &prefix,
-        &wopts,
-        &mut |p: &Path| {
-            say!(say, "Writing {}.", p.display());
-        },
-        early,
-    )?;
-    say!(say, "");
-    say!(
-        say,
-        "Output seconds:  {}",
-        out_start.elapsed().as_secs_f64()
-    );
-    say!(
-        say,
-        "Total running seconds:  {}",
-        start.elapsed().as_secs_f64()
-    );
-
-    if opts.verbose > 0 {
-        let s = &meshed.stats;
-        say!(say, "");
-        say!(say, "Statistics:");
-        say!(say, "");
-        say!(say, "  Input points: {}", s.input_points);
-        say!(say, "  Duplicate points: {}", s.duplicate_points);
-        say!(say, "");
-        say!(say, "  Mesh points: {}", meshed.mesh.points.len());
-        say!(say, "  Mesh tetrahedra: {}", s.output_tets);
-        say!(say, "  Convex hull faces: {}", s.hull_faces);
-        say!(say, "");
-        say!(say, "  Sorting seconds: {}", s.sort_secs);
-        say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
-        say!(say, "  Meshing seconds: {}", s.total_secs);
-        let rows = s.table1_rows();
-        if !rows.is_empty() {
-            say!(say, "");
-            say!(
-                say,
-                "  Constrained Delaunay (rows of Si & Shewchuk's Table 1):"
-            );
-            for (label, value) in rows {
-                say!(say, "    {label:<45} {value}");
-            }
-        }
-    }
-    if let Some(path) = &opts.stats_json {
-        let json = meshed.stats.to_json(&file.to_string_lossy());
-        std::fs::write(path, json + "\n").map_err(|e| {
-            Failure::new(tetcdt::error::EXIT_IO, anyhow!("{}: {e}", path.display()))
-        })?;
-    }
-
-    if opts.check {
-        say!(say, "");
-        say!(say, "Checking the mesh...");
-        if let Err(problems) = tetcdt::check::check_mesh(&plc, &meshed.mesh) {
-            return Err(check_failure(&problems));
-        }
-        say!(say, "Mesh check passed.");
-    }
-    Ok(EXIT_OK)
+    cli::run(inv, generated_by(&args), start)
 }
 
 /// The failure of `--check`: every problem, one per line.
@@ -343,7 +243,13 @@ fn main() {
             .location()
             .map(|l| format!(" at {}:{}", l.file(), l.line()))
             .unwrap_or_default();
-        let _ = writeln!(std::io::stderr(), "tetcdt: internal error: {msg}{at}");
+        let model = cli::current_model()
+            .map(|m| format!("{m}: "))
+            .unwrap_or_default();
+        let _ = writeln!(
+            std::io::stderr(),
+            "tetcdt: {model}internal error: {msg}{at}"
+        );
     }));
     let args: Vec<OsString> = std::env::args_os().skip(1).collect();
     let code = match std::panic::catch_unwind(move || run(args)) {
@@ -386,11 +292,12 @@ mod tests {
 
     #[test]
     fn parsed_arguments() {
-        let (opts, file) = parse_args(&os(&["m.node", "-fe", "-o", "out/x", "--check"]))
+        let inv = parse_args(&os(&["m.node", "-fe", "-o", "out/x", "--check"]))
             .ok()
             .unwrap()
             .unwrap();
-        assert_eq!(file, PathBuf::from("m.node"));
+        let opts = inv.opts;
+        assert_eq!(inv.files, [PathBuf::from("m.node")]);
         assert!(opts.all_faces && opts.write_edges && opts.check);
         assert_eq!(opts.output, Some(PathBuf::from("out/x")));
         let f = parse_args(&os(&["-q", "m.node"])).err().unwrap();

@@ -5,15 +5,17 @@ use crate::error::{Error, MeshError};
 use crate::options::Options;
 use crate::output::MeshOut;
 use crate::plc::Plc;
+use crate::progress::{Progress, Stage};
 use crate::stats::Stats;
 use crate::Meshed;
 use std::time::Instant;
 
-/// Runs the pipeline on `plc` as `opts` asks.
-pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
+/// Runs the pipeline on `plc` as `opts` asks, telling `progress` when each stage begins.
+pub fn run(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
     if opts.plc {
-        return run_plc(plc, opts);
+        return run_plc(plc, opts, progress);
     }
+    progress(Stage::Delaunay);
     let start = Instant::now();
     let mut stats = Stats {
         input_points: plc.points.len(),
@@ -57,7 +59,7 @@ pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
 }
 
 /// The `-p` pipeline: the constrained Delaunay tetrahedralization of the PLC, carved.
-fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
+fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
     if opts.facet_algo == crate::options::FacetAlgo::Flip {
         return Err(MeshError::Unsupported(
             "facet insertion by flips (-F) is not implemented yet".into(),
@@ -74,7 +76,7 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
             .max_steiner
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
     };
-    let done = crate::constrained::mesh_plc(plc, &popts)?;
+    let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress)?;
     let ps = done.stats;
     let stats = Stats {
         input_points: plc.points.len(),

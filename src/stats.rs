@@ -121,7 +121,8 @@ impl Stats {
     }
 }
 
-fn json_f64(x: f64) -> String {
+/// A number as JSON (`null` when not finite).
+pub fn json_f64(x: f64) -> String {
     if x.is_finite() {
         format!("{x}")
     } else {
@@ -129,7 +130,8 @@ fn json_f64(x: f64) -> String {
     }
 }
 
-fn json_string(s: &str) -> String {
+/// A string as a JSON string literal, escaped.
+pub fn json_string(s: &str) -> String {
     let mut out = String::from("\"");
     for c in s.chars() {
         match c {

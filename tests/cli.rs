@@ -100,7 +100,10 @@ fn usage_errors_exit_2_naming_the_switch() {
         ),
         (&[], "required arguments were not provided"),
         (&["-zQ"], "required arguments were not provided"),
-        (&["p.node", "q.node"], "unexpected argument 'q.node'"),
+        (
+            &["p.node", "q.node", "-o", "x"],
+            "-o/--output names the outputs of a single input, but 2 inputs were given",
+        ),
         (&["--bogus", "p.node"], "unexpected argument '--bogus'"),
         (
             &["p.node", "-o"],
@@ -772,7 +775,10 @@ fn an_open_surface_is_refused_before_meshing_naming_its_rim() {
     assert_eq!(code, 3, "{err}");
     assert!(err.contains("open and encloses no volume"), "{err}");
     assert!(err.contains("4 boundary edge(s)"), "{err}");
-    assert!(err.contains("4-5 ([0.0, 0.0, 1.0] to [1.0, 0.0, 1.0])"), "{err}");
+    assert!(
+        err.contains("4-5 ([0.0, 0.0, 1.0] to [1.0, 0.0, 1.0])"),
+        "{err}"
+    );
     assert_eq!(listing(dir.path()), vec!["open.off"]);
     // With -c the convex hull is meshed instead.
     let (code, _, err) = run_in(dir.path(), &["-pcQ", "open.off"]);

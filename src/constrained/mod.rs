@@ -20,6 +20,7 @@ use crate::geom::Point;
 use crate::mesh::VertexId;
 use crate::output::MeshOut;
 use crate::plc::Plc;
+use crate::progress::{Progress, Stage};
 use cavity::{insert_region, Outcome};
 use cdt::{edge_key, face_key, Cdt};
 use prepare::{prepare, PreparedPlc};
@@ -122,6 +123,15 @@ const MAX_RESTARTS: usize = 24;
 
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
+    mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
+}
+
+/// Like [`mesh_plc`], telling `progress` when each stage (of each attempt) begins.
+pub fn mesh_plc_with_progress(
+    plc: &Plc,
+    opts: &PlcOptions,
+    progress: Progress<'_>,
+) -> Result<PlcMesh, Error> {
     let mut prep = prepare(plc, opts.merge)?;
     if !opts.keep_hull {
         if let Some(rim) = enclosure::open_boundary(plc, &prep) {
@@ -149,7 +159,15 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     let mut facet_points: Vec<(usize, Point)> = Vec::new();
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     loop {
-        let outcome = match attempt(plc, &prep, &facet_points, &presplits, opts, &mut stats) {
+        let outcome = match attempt(
+            plc,
+            &prep,
+            &facet_points,
+            &presplits,
+            opts,
+            &mut stats,
+            progress,
+        ) {
             Err(Error::Mesh(MeshError::Failed(msg))) if msg.starts_with(UNFLAT_GROUP) => {
                 // Which group failed is in the message; split it and start again.
                 let sources: Vec<usize> = msg[UNFLAT_GROUP.len()..]
@@ -175,7 +193,7 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
         match outcome {
             Attempt::Done(cdt, seg_markers) => {
                 stats.facet_steiner_points = facet_points.len();
-                let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats)?;
+                let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
                 return Ok(PlcMesh {
                     mesh,
                     stats,
@@ -217,15 +235,18 @@ fn attempt(
     presplits: &[(usize, f64)],
     opts: &PlcOptions,
     stats: &mut PlcStats,
+    progress: Progress<'_>,
 ) -> Result<Attempt, Error> {
     let n_input = plc.points.len();
     let mut points = plc.points.clone();
     points.extend(facet_points.iter().map(|&(_, p)| p));
     // Duplicated input points go to their representative; only those are meshed.
+    progress(Stage::Delaunay);
     let t0 = Instant::now();
     let mut dt = Delaunay::build(&points)?.dt;
     stats.delaunay_secs = t0.elapsed().as_secs_f64();
 
+    progress(Stage::Segments);
     let t1 = Instant::now();
     let mut next_pert = points.len() as u32;
     let budget = opts.max_steiner.saturating_sub(facet_points.len());
@@ -240,6 +261,7 @@ fn attempt(
     stats.segment_secs = t1.elapsed().as_secs_f64();
     stats.steiner_points = facet_points.len() + subsegs.steiner_points;
 
+    progress(Stage::Facets);
     let t2 = Instant::now();
     let inv = dt.internal_ids(points.len());
     let mut cdt = Cdt::new(dt);
@@ -729,7 +751,9 @@ fn finish(
     seg_markers: &FxHashMap<(VertexId, VertexId), i32>,
     opts: &PlcOptions,
     stats: &mut PlcStats,
+    progress: Progress<'_>,
 ) -> Result<MeshOut, Error> {
+    progress(Stage::Carve);
     let t = Instant::now();
     let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
     stats.carve_secs = t.elapsed().as_secs_f64();
