@@ -239,8 +239,13 @@ fn check_constraints(
                 }
                 if !joined_along(mesh, &adj, a, b) {
                     // Edges between merged coplanar polygons are not constraints: they
-                    // need no subsegments, but their facets still cover them.
-                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, &rep, a, b) {
+                    // need no subsegments, but their facets still cover them. A polygon
+                    // dangling outside the closed surface is carved away with the
+                    // exterior (the mesher warns about it).
+                    if !edges.contains(&(a.min(b), a.max(b)))
+                        && is_segment(plc, &rep, a, b)
+                        && !outside_mesh(mesh, plc.points[a as usize], plc.points[b as usize])
+                    {
                         pr.push(format!(
                             "facet {}: edge ({}, {}) is not covered by subsegments",
                             fi + base,
@@ -252,6 +257,20 @@ fn check_constraints(
             }
         }
     }
+}
+
+/// True if the midpoint of `a`–`b` lies in no tet (closed) of the mesh.
+fn outside_mesh(mesh: &MeshOut, a: Point, b: Point) -> bool {
+    let q: Point = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+    let p = |v: u32| mesh.points[v as usize];
+    !mesh.tets.iter().any(|t| {
+        let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &p(t[3]));
+        (0..4).all(|i| {
+            let mut w = [p(t[0]), p(t[1]), p(t[2]), p(t[3])];
+            w[i] = q;
+            orient3d(&w[0], &w[1], &w[2], &w[3]) * o >= 0.0
+        })
+    })
 }
 
 /// The lowest-indexed point with the same coordinates, for each point.

@@ -193,7 +193,9 @@ pub fn mesh_plc_with_progress(
         match outcome {
             Attempt::Done(cdt, seg_markers) => {
                 stats.facet_steiner_points = facet_points.len();
-                let mesh = finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
+                let (mesh, more) =
+                    finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
+                warnings.extend(more);
                 return Ok(PlcMesh {
                     mesh,
                     stats,
@@ -752,7 +754,7 @@ fn finish(
     opts: &PlcOptions,
     stats: &mut PlcStats,
     progress: Progress<'_>,
-) -> Result<MeshOut, Error> {
+) -> Result<(MeshOut, Vec<String>), Error> {
     progress(Stage::Carve);
     let t = Instant::now();
     let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
@@ -813,6 +815,35 @@ fn finish(
         .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
         .collect();
     subsegments.sort_unstable();
+    // A polygon dangling in the exterior (a fin on a surface) is carved away with it;
+    // its edges then bound no tet and are not subsegments of the mesh.
+    let mut mesh_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
+    for t in &tets {
+        for a in 0..4 {
+            for b in a + 1..4 {
+                mesh_edges.insert((t[a].min(t[b]), t[a].max(t[b])));
+            }
+        }
+    }
+    let mut warnings = Vec::new();
+    let before = subsegments.len();
+    let mut first_lost = None;
+    subsegments.retain(|&([a, b], _)| {
+        let kept = mesh_edges.contains(&(a, b));
+        if !kept && first_lost.is_none() {
+            first_lost = Some((a, b));
+        }
+        kept
+    });
+    if let Some((a, b)) = first_lost {
+        warnings.push(format!(
+            "{} subsegment(s) lie outside the meshed domain and were removed with the exterior, \
+             first ({}, {}): a polygon dangles outside the closed surface",
+            before - subsegments.len(),
+            a as usize + plc.first_index,
+            b as usize + plc.first_index
+        ));
+    }
     stats.output_tets = tets.len();
     stats.output_subfaces = subfaces.len();
     let n_attr = plc.num_point_attrs;
@@ -827,7 +858,7 @@ fn finish(
     } else {
         (0, Vec::new())
     };
-    Ok(MeshOut {
+    let mesh = MeshOut {
         points,
         num_point_attrs: n_attr,
         point_attrs,
@@ -842,5 +873,6 @@ fn finish(
         first_index: plc.first_index,
         convex_hull_kept: opts.keep_hull,
         ..Default::default()
-    })
+    };
+    Ok((mesh, warnings))
 }
