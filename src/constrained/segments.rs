@@ -85,6 +85,15 @@ pub fn recover_segments(
             prev = (s, w);
         }
     }
+    // Longest segments first (the queue is a stack): their split points are the
+    // coarsest, and the shorter segments around them often need fewer points after.
+    // Each segment's pieces are then finished depth first, which keeps the splits of
+    // one segment consistent (processing all pieces by length costs 20% more points).
+    let sq = |pc: &Piece| {
+        let (a, b) = (dt.points[pc.u as usize], dt.points[pc.v as usize]);
+        (0..3).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum::<f64>()
+    };
+    queue.sort_by(|x, y| sq(x).total_cmp(&sq(y)));
     // Recovered pieces, indexed by both endpoints: an insertion can only remove edges
     // between vertices of its cavity, so only those pieces are checked again.
     let mut done = Recovered::default();
