@@ -28,6 +28,9 @@ pub struct Cdt {
     pub subsegs: FxHashMap<(VertexId, VertexId), i32>,
     /// Subfaces present in the mesh, with the index of their (merged) facet.
     pub subfaces: FxHashMap<[VertexId; 3], u32>,
+    /// Faces of the mesh when [`Cdt::index_faces`] ran, each with a tet that had it: a
+    /// hint that [`Cdt::has_face`] confirms in constant time while that tet is unchanged.
+    face_index: FxHashMap<[VertexId; 3], TetId>,
     scratch: Vec<TetId>,
 }
 
@@ -38,6 +41,7 @@ impl Cdt {
             dt,
             subsegs: FxHashMap::default(),
             subfaces: FxHashMap::default(),
+            face_index: FxHashMap::default(),
             scratch: Vec::new(),
         }
     }
@@ -53,6 +57,36 @@ impl Cdt {
         let v = self.dt.mesh.verts(t);
         let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c)?;
         Some(FaceRef::new(t, i))
+    }
+
+    /// Records every face of the mesh as it is now, for [`Cdt::has_face`].
+    pub fn index_faces(&mut self) {
+        let mesh = &self.dt.mesh;
+        let mut index = FxHashMap::default();
+        index.reserve(2 * mesh.real_tets().count() + 16);
+        for t in mesh.real_tets() {
+            let v = mesh.verts(t);
+            for f in FACE_VERTS {
+                index.insert(face_key([v[f[0]], v[f[1]], v[f[2]]]), t);
+            }
+        }
+        self.face_index = index;
+    }
+
+    /// True if `(a, b, c)` is a face of the mesh.
+    pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
+        if let Some(&t) = self.face_index.get(&face_key([a, b, c])) {
+            // The tet may have been deleted or reused since; if it still has the three
+            // vertices, the face is there.
+            let mesh = &self.dt.mesh;
+            if mesh.is_alive(t) {
+                let v = mesh.verts(t);
+                if v.contains(&a) && v.contains(&b) && v.contains(&c) {
+                    return true;
+                }
+            }
+        }
+        self.find_face(a, b, c).is_some()
     }
 
     /// True if `u`–`v` is a mesh edge.

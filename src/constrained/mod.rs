@@ -267,6 +267,7 @@ fn attempt(
     let t2 = Instant::now();
     let inv = dt.internal_ids(points.len());
     let mut cdt = Cdt::new(dt);
+    cdt.index_faces();
     let seg_index: FxHashMap<(u32, u32), usize> = prep
         .segments
         .iter()
@@ -396,7 +397,7 @@ fn attempt(
         }
         let mut missing = Vec::new();
         for t in &tris {
-            if cdt.find_face(t[0], t[1], t[2]).is_some() {
+            if cdt.has_face(t[0], t[1], t[2]) {
                 cdt.subfaces.insert(face_key(*t), fi as u32);
             } else {
                 missing.push(*t);
@@ -570,11 +571,23 @@ fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -
 /// are returned, and the construction starts again.
 fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Point)>, Vec<Edge>) {
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
-    for (k, &f) in &cdt.subfaces {
-        facet_verts.entry(f).or_default().extend(k.iter().copied());
+    {
+        // A shim has four vertices on one facet: facets of three vertices have none.
+        let mut count: FxHashMap<u32, u32> = FxHashMap::default();
+        for &f in cdt.subfaces.values() {
+            *count.entry(f).or_default() += 1;
+        }
+        for (k, &f) in &cdt.subfaces {
+            if count[&f] > 1 {
+                facet_verts.entry(f).or_default().extend(k.iter().copied());
+            }
+        }
     }
     let mut steiner = Vec::new();
     let mut split_edges = Vec::new();
+    if facet_verts.is_empty() {
+        return (steiner, split_edges);
+    }
     for _round in 0..8 {
         let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
@@ -582,14 +595,15 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Po
         let mut needs: Vec<(usize, Point)> = Vec::new();
         for &t in &carved.tets {
             let v = cdt.dt.mesh.verts(t);
-            let faces: Vec<[VertexId; 3]> = crate::mesh::FACE_VERTS
-                .iter()
-                .map(|fv| face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
-                .collect();
+            let faces: [[VertexId; 3]; 4] =
+                crate::mesh::FACE_VERTS.map(|fv| face_key([v[fv[0]], v[fv[1]], v[fv[2]]]));
             let Some(facet) = faces.iter().find_map(|k| cdt.subfaces.get(k).copied()) else {
                 continue;
             };
-            if !v.iter().all(|x| facet_verts[&facet].contains(x)) {
+            let Some(on_facet) = facet_verts.get(&facet) else {
+                continue;
+            };
+            if !v.iter().all(|x| on_facet.contains(x)) {
                 continue;
             }
             let (sub, free): (Vec<[VertexId; 3]>, Vec<[VertexId; 3]>) =

@@ -85,6 +85,24 @@ pub fn recover_segments(
             prev = (s, w);
         }
     }
+    // The pieces that are edges at the start, found in one pass over the tets (a walk
+    // around each would cost much more).
+    let present: rustc_hash::FxHashSet<(VertexId, VertexId)> = {
+        let wanted: rustc_hash::FxHashSet<(VertexId, VertexId)> =
+            queue.iter().map(|pc| key(pc.u, pc.v)).collect();
+        let mut present = rustc_hash::FxHashSet::default();
+        for t in dt.mesh.real_tets() {
+            let v = dt.mesh.verts(t);
+            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                let k = key(v[i], v[j]);
+                if wanted.contains(&k) {
+                    present.insert(k);
+                }
+            }
+        }
+        present
+    };
+    let mut done = Recovered::default();
     // Longest segments first (the queue is a stack): their split points are the
     // coarsest, and the shorter segments around them often need fewer points after.
     // Each segment's pieces are then finished depth first, which keeps the splits of
@@ -94,14 +112,20 @@ pub fn recover_segments(
         (0..3).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum::<f64>()
     };
     queue.sort_by(|x, y| sq(x).total_cmp(&sq(y)));
-    // Recovered pieces, indexed by both endpoints: an insertion can only remove edges
-    // between vertices of its cavity, so only those pieces are checked again.
-    let mut done = Recovered::default();
+    // Recovered pieces are indexed by both endpoints: an insertion can only remove
+    // edges between vertices of its cavity, so only those pieces are checked again.
     let mut scratch = Vec::new();
     let mut cavity = Vec::new();
+    // Vertices of some insertion's cavity: an edge between two untouched vertices that
+    // was in the mesh at the start still is.
+    let mut touched = vec![false; dt.points.len()];
     loop {
         while let Some(pc) = queue.pop() {
-            if dt.has_edge(pc.u, pc.v, &mut scratch) {
+            let hit = |v: VertexId| touched.get(v as usize).copied().unwrap_or(true);
+            let untouched = !(hit(pc.u) && hit(pc.v));
+            if (untouched && present.contains(&key(pc.u, pc.v)))
+                || dt.has_edge(pc.u, pc.v, &mut scratch)
+            {
                 done.push(pc);
                 continue;
             }
@@ -132,6 +156,11 @@ pub fn recover_segments(
             steiner += 1;
             splits[pc.seg].push((s, w));
             dt.last_cavity_vertices(&mut cavity);
+            for &x in &cavity {
+                if let Some(t) = touched.get_mut(x as usize) {
+                    *t = true;
+                }
+            }
             done.recheck(dt, &cavity, w, &mut queue, &mut scratch);
             queue.push(Piece {
                 seg: pc.seg,
@@ -149,7 +178,7 @@ pub fn recover_segments(
             });
         }
         // A last full check, in case a piece was lost without a recorded cavity.
-        done.recheck_all(dt, &mut queue, &mut scratch);
+        done.recheck_all(dt, &mut queue);
         if queue.is_empty() {
             break;
         }
@@ -220,22 +249,38 @@ impl Recovered {
         }
     }
 
-    /// Sends back to `queue` every piece that is no longer an edge.
-    fn recheck_all(
-        &mut self,
-        dt: &Delaunay,
-        queue: &mut Vec<Piece>,
-        scratch: &mut Vec<crate::mesh::TetId>,
-    ) {
+    /// Sends back to `queue` every piece that is no longer an edge (one pass over the
+    /// tets).
+    fn recheck_all(&mut self, dt: &Delaunay, queue: &mut Vec<Piece>) {
+        let mut missing: rustc_hash::FxHashSet<(VertexId, VertexId)> = self
+            .pieces
+            .iter()
+            .flatten()
+            .map(|pc| key(pc.u, pc.v))
+            .collect();
+        for t in dt.mesh.real_tets() {
+            let v = dt.mesh.verts(t);
+            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                missing.remove(&key(v[i], v[j]));
+            }
+            if missing.is_empty() {
+                return;
+            }
+        }
         for slot in &mut self.pieces {
             if let Some(pc) = *slot {
-                if !dt.has_edge(pc.u, pc.v, scratch) {
+                if missing.contains(&key(pc.u, pc.v)) {
                     *slot = None;
                     queue.push(pc);
                 }
             }
         }
     }
+}
+
+/// Sorted key of an edge.
+fn key(a: VertexId, b: VertexId) -> (VertexId, VertexId) {
+    (a.min(b), a.max(b))
 }
 
 /// Vertices where two segments meet at less than 90 degrees.
