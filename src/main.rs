@@ -30,6 +30,8 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
   -Q     Quiet: no terminal output except errors
   -V     Verbose: print statistics (-VV for more)
+  -d     Only detect intersecting facets: list them, write their triangles to .face
+         (with the points in .node); nothing is written when there are none
 Other TetGen switches (-q, -a, -A, -r, -Y, -T, -S, -o2, -g, -k, ...) are recognised and refused.
 
 Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
@@ -197,6 +199,10 @@ fn run(args: Vec<OsString>) -> Result<i32, Failure> {
 
     say!(say, "Opening {}.", file.display());
     let plc = tetcdt::io::read_plc(&file).map_err(tetcdt::Error::from)?;
+    if opts.detect_intersections {
+        wopts.comment = Some(generated_by(&args));
+        return detect_only(&plc, &prefix, &wopts, &say);
+    }
 
     if opts.plc {
         say!(say, "Constrained Delaunay tetrahedralization...");
@@ -289,6 +295,30 @@ fn run(args: Vec<OsString>) -> Result<i32, Failure> {
         }
         say!(say, "Mesh check passed.");
     }
+    Ok(EXIT_OK)
+}
+
+/// `-d`: report the intersecting facets and write their triangles; no meshing.
+fn detect_only(
+    plc: &tetcdt::Plc,
+    prefix: &Path,
+    wopts: &WriteOptions,
+    say: &Say,
+) -> Result<i32, Failure> {
+    say!(say, "Detecting self-intersecting facets...");
+    let found = tetcdt::precheck::detect::detect(plc).map_err(tetcdt::Error::from)?;
+    if !say.quiet {
+        let mut err = std::io::stderr().lock();
+        for w in &found.warnings {
+            let _ = writeln!(err, "Warning: {w}");
+        }
+    }
+    for line in found.report(plc) {
+        say!(say, "{line}");
+    }
+    tetcdt::precheck::detect::write(plc, &found.found, prefix, wopts, &mut |p: &Path| {
+        say!(say, "Writing {}.", p.display());
+    })?;
     Ok(EXIT_OK)
 }
 

@@ -63,6 +63,8 @@ pub struct Options {
     pub keep_hull: bool,
     /// `-A`: give each tet its region attribute; needs `-p`.
     pub region_attributes: bool,
+    /// `-d`: only detect intersecting facets, report them and write their triangles.
+    pub detect_intersections: bool,
     /// `-S`: the most Steiner points to add (`-S` alone or `-S0` means no limit).
     pub max_steiner: Option<usize>,
 }
@@ -178,7 +180,6 @@ const REFUSED: &[(char, Arg, &str)] = &[
     ('m', Arg::None, "mesh sizing function"),
     ('T', Arg::Numbers, "coplanarity tolerance"),
     ('R', Arg::Numbers, "mesh coarsening"),
-    ('d', Arg::None, "detection of self-intersections"),
     ('D', Arg::Numbers, "conforming Delaunay refinement"),
     (
         'L',
@@ -316,6 +317,10 @@ impl Options {
                 'c' => {
                     self.keep_hull = true;
                     seen.keep_hull = true;
+                    true
+                }
+                'd' => {
+                    self.detect_intersections = true;
                     true
                 }
                 'A' => {
@@ -581,6 +586,13 @@ mod tests {
             ),
             (&["O0Q"], Options { quiet: true, ..d() }),
             (
+                &["-d"],
+                Options {
+                    detect_intersections: true,
+                    ..d()
+                },
+            ),
+            (
                 &["-fenzIQV"],
                 Options {
                     all_faces: true,
@@ -632,7 +644,7 @@ mod tests {
             (&["-A"], &["-A (region attributes) needs -p"]),
             (&["-c"], &["-c (convex hull retention) needs -p"]),
             (&["-M"], &["-M (no merging of coplanar facets) needs -p"]),
-            (&["-d"], &["-d (detection"]),
+            (&["-d5"], &["-d does not take the argument \"5\""]),
             (&["-T1e-8"], &["-T1e-8 (coplanarity"]),
             (&["-S1y"], &["unknown switch -y"]),
             (&["-R"], &["-R (mesh coarsening"]),

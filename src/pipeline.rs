@@ -74,7 +74,9 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
             .max_steiner
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
     };
+    let mut warnings = crate::precheck::check(plc)?;
     let done = crate::constrained::mesh_plc(plc, &popts)?;
+    warnings.extend(done.warnings);
     let ps = done.stats;
     let stats = Stats {
         input_points: plc.points.len(),
@@ -87,6 +89,6 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
     Ok(Meshed {
         mesh: done.mesh,
         stats,
-        warnings: done.warnings,
+        warnings,
     })
 }

@@ -128,9 +128,12 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     let mut warnings = Vec::new();
     for &(dup, kept) in &prep.duplicates {
         warnings.push(format!(
-            "point {} coincides with point {} and is merged with it",
+            "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
             dup as usize + plc.first_index,
-            kept as usize + plc.first_index
+            kept as usize + plc.first_index,
+            plc.points[kept as usize][0],
+            plc.points[kept as usize][1],
+            plc.points[kept as usize][2]
         ));
     }
     let mut stats = PlcStats {
@@ -702,11 +705,10 @@ fn finish(
     let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
     stats.carve_secs = t.elapsed().as_secs_f64();
     if carved.tets.is_empty() {
-        return Err(MeshError::InvalidPlc(
-            "no tetrahedra remain after removing the exterior: the surface does not enclose a volume \
-             (is it closed?)"
-                .into(),
-        )
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::empty_domain_message(plc),
+        }
         .into());
     }
     let n_out = cdt

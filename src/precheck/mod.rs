@@ -1,0 +1,413 @@
+//! Checks of a PLC before meshing: every defect that makes the PLC invalid is reported
+//! with the file, the elements (numbered as in the file) and, where it helps, coordinates.
+//!
+//! * vertex indices out of range, non-finite coordinates (also of hole and region points);
+//! * polygons that repeat a vertex, or whose vertices are all collinear;
+//! * duplicate polygons (the same vertices in any order, coincident points merged);
+//! * facets that intersect other than at shared vertices and edges ([`intersections`]).
+//!
+//! Exactly coincident points are not an error: they are merged, with a warning (as TetGen
+//! does). An open surface is refused only once carving shows that nothing would remain
+//! ([`empty_domain_message`]), since open facets inside a closed one, or `-c`, are fine.
+
+pub mod bvh;
+pub mod detect;
+pub mod surface;
+pub mod tritri;
+
+use crate::error::InputError;
+use crate::plc::Plc;
+use bvh::{Aabb, Bvh};
+use rustc_hash::FxHashMap;
+use surface::clean_ring;
+pub use tritri::Contact;
+
+/// How many offending elements a message lists before "and N more".
+const SHOWN: usize = 5;
+
+/// One pair of intersecting facets, at one pair of their triangles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Intersection {
+    /// The two input facets (0-based), the lower first.
+    pub facets: [usize; 2],
+    /// A triangle of each facet where they meet (0-based representative vertex ids).
+    pub tris: [[u32; 3]; 2],
+    /// How they meet.
+    pub kind: Contact,
+}
+
+/// For each point, the lowest-indexed point with exactly equal coordinates.
+pub fn representatives(points: &[[f64; 3]]) -> Vec<u32> {
+    let mut first: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            // Adding 0.0 turns -0.0 into 0.0, which compares equal to it.
+            *first
+                .entry(p.map(|v| (v + 0.0).to_bits()))
+                .or_insert(i as u32)
+        })
+        .collect()
+}
+
+/// A facet's name in messages: its number as in the file, and its line when known.
+pub fn facet_name(plc: &Plc, fi: usize) -> String {
+    match plc.facets.get(fi).map(|f| f.line).unwrap_or(0) {
+        0 => format!("facet {}", fi + plc.first_index),
+        line => format!("facet {} (line {line})", fi + plc.first_index),
+    }
+}
+
+/// A point's number as in the file, with its coordinates.
+fn point_name(plc: &Plc, v: u32) -> String {
+    let p = plc.points[v as usize];
+    format!(
+        "{} ({}, {}, {})",
+        v as usize + plc.first_index,
+        p[0],
+        p[1],
+        p[2]
+    )
+}
+
+/// A triangle's vertices as numbered in the file.
+fn tri_name(plc: &Plc, t: [u32; 3]) -> String {
+    let b = plc.first_index;
+    format!(
+        "({}, {}, {})",
+        t[0] as usize + b,
+        t[1] as usize + b,
+        t[2] as usize + b
+    )
+}
+
+/// "; and N more" when a list was cut.
+fn more(total: usize) -> String {
+    if total > SHOWN {
+        format!("; and {} more", total - SHOWN)
+    } else {
+        String::new()
+    }
+}
+
+/// Runs every check (the intersection test too) and returns the warnings to show; the
+/// first defect found is the error.
+pub fn check(plc: &Plc) -> Result<Vec<String>, InputError> {
+    let rep = check_elements(plc)?;
+    check_duplicates(plc, &rep)?;
+    let mut warnings = Vec::new();
+    let found = intersections(plc, &rep, &mut warnings);
+    if !found.is_empty() {
+        return Err(invalid(plc, intersection_message(plc, &found)));
+    }
+    Ok(warnings)
+}
+
+fn invalid(plc: &Plc, msg: String) -> InputError {
+    InputError::Invalid {
+        file: plc.source.clone(),
+        msg,
+    }
+}
+
+/// The checks of single elements (ranges, finite coordinates, repeated and collinear
+/// vertices); returns the representatives of coincident points.
+pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
+    let n = plc.points.len();
+    for (i, p) in plc.points.iter().enumerate() {
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(invalid(
+                plc,
+                format!(
+                    "point {} has a non-finite coordinate ({}, {}, {})",
+                    i + plc.first_index,
+                    p[0],
+                    p[1],
+                    p[2]
+                ),
+            ));
+        }
+    }
+    let seeds = plc
+        .holes
+        .iter()
+        .enumerate()
+        .map(|(i, h)| (format!("hole {}", i + 1), *h))
+        .chain(
+            plc.regions
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (format!("region {}", i + 1), r.point)),
+        )
+        .chain(plc.facets.iter().enumerate().flat_map(|(fi, f)| {
+            f.holes.iter().enumerate().map(move |(i, h)| {
+                (
+                    format!("hole {} of facet {}", i + 1, fi + plc.first_index),
+                    *h,
+                )
+            })
+        }));
+    for (name, p) in seeds {
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(invalid(
+                plc,
+                format!(
+                    "{name} has a non-finite coordinate ({}, {}, {})",
+                    p[0], p[1], p[2]
+                ),
+            ));
+        }
+    }
+    for (fi, f) in plc.facets.iter().enumerate() {
+        for (pi, poly) in f.polygons.iter().enumerate() {
+            let at = || format!("{}, polygon {}", facet_name(plc, fi), pi + 1);
+            if let Some(&v) = poly.iter().find(|&&v| v as usize >= n) {
+                return Err(invalid(
+                    plc,
+                    format!(
+                        "{}: vertex {} is out of range ({} points, numbered from {})",
+                        at(),
+                        v as usize + plc.first_index,
+                        n,
+                        plc.first_index
+                    ),
+                ));
+            }
+            if poly.len() >= 3 {
+                let mut seen: FxHashMap<u32, usize> = FxHashMap::default();
+                for (k, &v) in poly.iter().enumerate() {
+                    if let Some(j) = seen.insert(v, k) {
+                        return Err(invalid(
+                            plc,
+                            format!(
+                                "{}: vertex {} is repeated (positions {} and {} of {})",
+                                at(),
+                                v as usize + plc.first_index,
+                                j + 1,
+                                k + 1,
+                                poly.len()
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    let rep = representatives(&plc.points);
+    // Polygons whose vertices are all collinear (after merging coincident points).
+    for (fi, f) in plc.facets.iter().enumerate() {
+        for (pi, poly) in f.polygons.iter().enumerate() {
+            let ring = clean_ring(poly, &rep);
+            if ring.len() >= 3 && all_collinear(&plc.points, &ring) {
+                return Err(invalid(
+                    plc,
+                    format!(
+                        "{}, polygon {}: its {} vertices are collinear: {}",
+                        facet_name(plc, fi),
+                        pi + 1,
+                        ring.len(),
+                        ring.iter()
+                            .take(SHOWN)
+                            .map(|&v| point_name(plc, v))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                            + &more(ring.len())
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(rep)
+}
+
+/// Duplicate polygons: the same set of (representative) vertices.
+pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
+    let mut by_set: FxHashMap<Vec<u32>, (usize, usize)> = FxHashMap::default();
+    let mut dups: Vec<((usize, usize), (usize, usize))> = Vec::new();
+    for (fi, f) in plc.facets.iter().enumerate() {
+        for (pi, poly) in f.polygons.iter().enumerate() {
+            let mut key = clean_ring(poly, rep);
+            if key.len() < 3 {
+                continue;
+            }
+            key.sort_unstable();
+            if let Some(&first) = by_set.get(&key) {
+                dups.push((first, (fi, pi)));
+            } else {
+                by_set.insert(key, (fi, pi));
+            }
+        }
+    }
+    if !dups.is_empty() {
+        let list: Vec<String> = dups
+            .iter()
+            .take(SHOWN)
+            .map(|&((fa, pa), (fb, pb))| {
+                format!(
+                    "{}, polygon {} and {}, polygon {}",
+                    facet_name(plc, fa),
+                    pa + 1,
+                    facet_name(plc, fb),
+                    pb + 1
+                )
+            })
+            .collect();
+        return Err(invalid(
+            plc,
+            format!(
+                "{} duplicate polygon(s) (the same vertices as an earlier one): {}{}",
+                dups.len(),
+                list.join("; "),
+                more(dups.len())
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Exact test: are all vertices of the ring on one line? (Every axis projection has zero
+/// orientation for every vertex against the first two distinct ones.)
+fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
+    let p0 = points[ring[0] as usize];
+    let Some(p1) = ring.iter().map(|&v| points[v as usize]).find(|p| *p != p0) else {
+        return true;
+    };
+    ring.iter().all(|&v| {
+        let q = points[v as usize];
+        (0..3).all(|k| {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let c = |p: [f64; 3]| robust::Coord { x: p[i], y: p[j] };
+            robust::orient2d(c(p0), c(p1), c(q)) == 0.0
+        })
+    })
+}
+
+/// Every pair of input facets that meet other than at shared vertices and edges, at the
+/// first pair of their triangles found, sorted by facets. Facets that cannot be
+/// triangulated are left out, with a warning pushed to `warnings`.
+pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Vec<Intersection> {
+    let surf = surface::triangulate(plc, rep);
+    for (fi, why) in &surf.skipped {
+        warnings.push(format!(
+            "{} could not be triangulated for the intersection check ({why}); it was not checked",
+            facet_name(plc, *fi)
+        ));
+    }
+    let pts = &plc.points;
+    let corners = |t: [u32; 3]| t.map(|v| pts[v as usize]);
+    let boxes: Vec<Aabb> = surf
+        .tris
+        .iter()
+        .map(|t| {
+            let c = corners(t.v);
+            [
+                std::array::from_fn(|k| c[0][k].min(c[1][k]).min(c[2][k])),
+                std::array::from_fn(|k| c[0][k].max(c[1][k]).max(c[2][k])),
+            ]
+        })
+        .collect();
+    let bvh = Bvh::build(&boxes);
+    let mut found: FxHashMap<(usize, usize), Intersection> = FxHashMap::default();
+    bvh.overlapping_pairs(&boxes, |i, j| {
+        let (a, b) = (&surf.tris[i], &surf.tris[j]);
+        if a.facet == b.facet {
+            return;
+        }
+        let (fa, fb) = (a.facet as usize, b.facet as usize);
+        let key = (fa.min(fb), fa.max(fb));
+        if found.contains_key(&key) {
+            return;
+        }
+        if let Some(kind) = tritri::contact(a.v, corners(a.v), b.v, corners(b.v)) {
+            let tris = if fa < fb { [a.v, b.v] } else { [b.v, a.v] };
+            found.insert(
+                key,
+                Intersection {
+                    facets: [key.0, key.1],
+                    tris,
+                    kind,
+                },
+            );
+        }
+    });
+    let mut out: Vec<Intersection> = found.into_values().collect();
+    out.sort_by_key(|x| x.facets);
+    out
+}
+
+/// One line per intersecting pair, for reports.
+pub fn intersection_line(plc: &Plc, x: &Intersection) -> String {
+    format!(
+        "{} and {} ({}) at triangles {} and {}",
+        facet_name(plc, x.facets[0]),
+        facet_name(plc, x.facets[1]),
+        x.kind.name(),
+        tri_name(plc, x.tris[0]),
+        tri_name(plc, x.tris[1])
+    )
+}
+
+/// The error text for intersecting facets: the count and the first pairs.
+pub fn intersection_message(plc: &Plc, found: &[Intersection]) -> String {
+    let list: Vec<String> = found
+        .iter()
+        .take(SHOWN)
+        .map(|x| intersection_line(plc, x))
+        .collect();
+    format!(
+        "{} pair(s) of facets intersect (-d lists them all and writes their triangles):\n  {}{}",
+        found.len(),
+        list.join("\n  "),
+        more(found.len())
+    )
+}
+
+/// The error text when carving leaves nothing: the boundary edges of an open surface
+/// (edges of exactly one polygon), or why a closed one encloses nothing.
+pub fn empty_domain_message(plc: &Plc) -> String {
+    let rep = representatives(&plc.points);
+    let mut uses: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    let mut order: Vec<(u32, u32)> = Vec::new();
+    for f in &plc.facets {
+        for poly in &f.polygons {
+            if poly.iter().any(|&v| v as usize >= rep.len()) {
+                continue;
+            }
+            let r = clean_ring(poly, &rep);
+            if r.len() < 3 {
+                continue;
+            }
+            for k in 0..r.len() {
+                let (a, b) = (r[k], r[(k + 1) % r.len()]);
+                let e = (a.min(b), a.max(b));
+                let c = uses.entry(e).or_insert(0);
+                if *c == 0 {
+                    order.push(e);
+                }
+                *c += 1;
+            }
+        }
+    }
+    let open: Vec<(u32, u32)> = order.into_iter().filter(|e| uses[e] == 1).collect();
+    let head =
+        "the meshed domain would be empty: no tetrahedron remains after removing the exterior";
+    if open.is_empty() {
+        return format!(
+            "{head}; the polygons leave no gap, so the hole points or the polygons' \
+             arrangement remove everything (-c keeps the convex hull)"
+        );
+    }
+    let list: Vec<String> = open
+        .iter()
+        .take(SHOWN)
+        .map(|&(a, b)| format!("{} – {}", point_name(plc, a), point_name(plc, b)))
+        .collect();
+    format!(
+        "{head}, because the surface is not closed: {} boundary edge(s) (edges of only one \
+         polygon): {}{} (-c keeps the convex hull)",
+        open.len(),
+        list.join("; "),
+        more(open.len())
+    )
+}

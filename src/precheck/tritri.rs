@@ -1,0 +1,284 @@
+//! Exact intersection tests between closed triangles, from the signs of `orient3d` and,
+//! for coplanar configurations, of `orient2d` on a coordinate projection in which the
+//! plane does not degenerate (an affine map, so every 2D sign is the true in-plane one).
+//!
+//! Triangles are given with their vertex ids (duplicate points already merged, so two
+//! different ids never have equal coordinates). Sharing vertices is legitimate: two
+//! triangles sharing one vertex may meet only there, two sharing an edge only along it.
+
+use crate::geom::{orient3d, Point};
+
+/// How two triangles meet, when they meet where they should not.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Contact {
+    /// An edge of one passes through the interior of the other.
+    Crossing,
+    /// They meet only on their boundaries (a vertex on the other, an edge touching), not
+    /// at shared vertices or edges.
+    Touching,
+    /// They lie in one plane and overlap.
+    Overlap,
+    /// They have the same three vertices.
+    Duplicate,
+}
+
+impl Contact {
+    /// A short word for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Contact::Crossing => "crossing",
+            Contact::Touching => "touching",
+            Contact::Overlap => "coplanar overlap",
+            Contact::Duplicate => "duplicate",
+        }
+    }
+}
+
+/// The sign of `orient3d` as -1, 0 or 1.
+fn o3(a: &Point, b: &Point, c: &Point, d: &Point) -> i8 {
+    sign(orient3d(a, b, c, d))
+}
+
+fn sign(x: f64) -> i8 {
+    (x > 0.0) as i8 - (x < 0.0) as i8
+}
+
+/// A coordinate projection: the two axes kept.
+type Axes = (usize, usize);
+
+/// The sign of `orient2d` of the projections of `a, b, c` on `ax`.
+fn o2(a: &Point, b: &Point, c: &Point, ax: Axes) -> i8 {
+    let p = |q: &Point| robust::Coord {
+        x: q[ax.0],
+        y: q[ax.1],
+    };
+    sign(robust::orient2d(p(a), p(b), p(c)))
+}
+
+/// A projection in which triangle `abc` keeps a nonzero area, if it is not degenerate.
+fn axes_of(a: &Point, b: &Point, c: &Point) -> Option<Axes> {
+    (0..3)
+        .map(|k| ((k + 1) % 3, (k + 2) % 3))
+        .find(|&ax| o2(a, b, c, ax) != 0)
+}
+
+/// Whether `r`, collinear with `p` and `q`, lies on the closed segment `pq`.
+fn between(p: &Point, q: &Point, r: &Point) -> bool {
+    (0..3).all(|k| p[k].min(q[k]) <= r[k] && r[k] <= p[k].max(q[k]))
+}
+
+/// Whether the closed segments `pq` and `rs`, in a plane that `ax` does not degenerate, meet.
+fn seg_seg(p: &Point, q: &Point, r: &Point, s: &Point, ax: Axes) -> bool {
+    let (d1, d2) = (o2(p, q, r, ax), o2(p, q, s, ax));
+    let (d3, d4) = (o2(r, s, p, ax), o2(r, s, q, ax));
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    (d1 == 0 && between(p, q, r))
+        || (d2 == 0 && between(p, q, s))
+        || (d3 == 0 && between(r, s, p))
+        || (d4 == 0 && between(r, s, q))
+}
+
+/// Whether `p`, in the plane of the non-degenerate triangle `t`, lies in the closed triangle.
+fn point_in(p: &Point, t: &[Point; 3], ax: Axes) -> bool {
+    let s = o2(&t[0], &t[1], &t[2], ax);
+    (0..3).all(|k| o2(&t[k], &t[(k + 1) % 3], p, ax) * s >= 0)
+}
+
+/// Whether the closed segment `pq` meets the closed triangle `t`.
+fn seg_tri(p: &Point, q: &Point, t: &[Point; 3]) -> bool {
+    let (sp, sq) = (o3(&t[0], &t[1], &t[2], p), o3(&t[0], &t[1], &t[2], q));
+    if sp * sq > 0 {
+        return false;
+    }
+    let Some(ax) = axes_of(&t[0], &t[1], &t[2]) else {
+        return false;
+    };
+    match (sp, sq) {
+        (0, 0) => {
+            point_in(p, t, ax)
+                || point_in(q, t, ax)
+                || (0..3).any(|k| seg_seg(p, q, &t[k], &t[(k + 1) % 3], ax))
+        }
+        (0, _) => point_in(p, t, ax),
+        (_, 0) => point_in(q, t, ax),
+        _ => {
+            let s: [i8; 3] = std::array::from_fn(|k| o3(p, q, &t[k], &t[(k + 1) % 3]));
+            !(s.contains(&1) && s.contains(&-1))
+        }
+    }
+}
+
+/// Whether the closed segment `pq` passes through the interior of `t`, crossing its plane.
+fn seg_crosses_tri(p: &Point, q: &Point, t: &[Point; 3]) -> bool {
+    let (sp, sq) = (o3(&t[0], &t[1], &t[2], p), o3(&t[0], &t[1], &t[2], q));
+    if sp * sq >= 0 {
+        return false;
+    }
+    let s: [i8; 3] = std::array::from_fn(|k| o3(p, q, &t[k], &t[(k + 1) % 3]));
+    s == [1; 3] || s == [-1; 3]
+}
+
+/// Whether two coplanar closed triangles meet (`ax` keeps their plane non-degenerate).
+fn coplanar_meet(t: &[Point; 3], u: &[Point; 3], ax: Axes) -> bool {
+    (0..3).any(|i| (0..3).any(|j| seg_seg(&t[i], &t[(i + 1) % 3], &u[j], &u[(j + 1) % 3], ax)))
+        || point_in(&u[0], t, ax)
+        || point_in(&t[0], u, ax)
+}
+
+/// Whether ray `v → b` (without `v`) enters the closed triangle `(v, e, f)`: `b` is in its
+/// plane and inside its angle at `v`.
+fn ray_enters(v: &Point, b: &Point, e: &Point, f: &Point) -> bool {
+    if o3(v, e, f, b) != 0 {
+        return false;
+    }
+    let Some(ax) = axes_of(v, e, f) else {
+        return false;
+    };
+    let s = o2(v, e, f, ax);
+    o2(v, e, b, ax) * s >= 0 && o2(v, b, f, ax) * s >= 0
+}
+
+/// Tests two triangles given by vertex ids and coordinates; `None` when they meet only
+/// at shared vertices or along a shared edge (or not at all).
+pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Option<Contact> {
+    let shared: Vec<(usize, usize)> = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .filter(|&(i, j)| ti[i] == ui[j])
+        .collect();
+    let meet = match shared.len() {
+        0 => {
+            let s: [i8; 3] = std::array::from_fn(|k| o3(&t[0], &t[1], &t[2], &u[k]));
+            if s == [1; 3] || s == [-1; 3] {
+                return None;
+            }
+            let r: [i8; 3] = std::array::from_fn(|k| o3(&u[0], &u[1], &u[2], &t[k]));
+            if r == [1; 3] || r == [-1; 3] {
+                return None;
+            }
+            if s == [0; 3] {
+                let ax = axes_of(&t[0], &t[1], &t[2])?;
+                return coplanar_meet(&t, &u, ax).then_some(Contact::Overlap);
+            }
+            (0..3).any(|k| seg_tri(&t[k], &t[(k + 1) % 3], &u))
+                || (0..3).any(|k| seg_tri(&u[k], &u[(k + 1) % 3], &t))
+        }
+        1 => {
+            // Rotate both so that the shared vertex comes first.
+            let (i, j) = shared[0];
+            let t = [t[i], t[(i + 1) % 3], t[(i + 2) % 3]];
+            let u = [u[j], u[(j + 1) % 3], u[(j + 2) % 3]];
+            let v = t[0];
+            seg_tri(&t[1], &t[2], &u)
+                || seg_tri(&u[1], &u[2], &t)
+                || ray_enters(&v, &t[1], &u[1], &u[2])
+                || ray_enters(&v, &t[2], &u[1], &u[2])
+                || ray_enters(&v, &u[1], &t[1], &t[2])
+                || ray_enters(&v, &u[2], &t[1], &t[2])
+        }
+        2 => {
+            let c = t[(0..3).find(|&i| shared.iter().all(|s| s.0 != i))?];
+            let f = u[(0..3).find(|&j| shared.iter().all(|s| s.1 != j))?];
+            let (a, b) = (t[shared[0].0], t[shared[1].0]);
+            if o3(&a, &b, &c, &f) != 0 {
+                return None;
+            }
+            let ax = axes_of(&a, &b, &c)?;
+            return (o2(&a, &b, &c, ax) * o2(&a, &b, &f, ax) > 0).then_some(Contact::Overlap);
+        }
+        _ => return Some(Contact::Duplicate),
+    };
+    if !meet {
+        return None;
+    }
+    let coplanar = (0..3).all(|k| o3(&t[0], &t[1], &t[2], &u[k]) == 0);
+    Some(if coplanar {
+        Contact::Overlap
+    } else if (0..3).any(|k| seg_crosses_tri(&t[k], &t[(k + 1) % 3], &u))
+        || (0..3).any(|k| seg_crosses_tri(&u[k], &u[(k + 1) % 3], &t))
+    {
+        Contact::Crossing
+    } else {
+        Contact::Touching
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const A: [u32; 3] = [0, 1, 2];
+    const B: [u32; 3] = [3, 4, 5];
+    /// The unit right triangle in the plane z = 0.
+    const T: [Point; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+    fn c(u: [Point; 3]) -> Option<Contact> {
+        contact(A, T, B, u)
+    }
+
+    #[test]
+    fn disjoint_and_crossing() {
+        assert_eq!(c([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]]), None);
+        // A triangle through the interior of T.
+        let x = [[0.2, 0.2, -1.0], [0.2, 0.2, 1.0], [3.0, 3.0, 0.5]];
+        assert_eq!(c(x), Some(Contact::Crossing));
+        // Passing beside T, through its plane.
+        let y = [[2.0, 2.0, -1.0], [2.0, 2.0, 1.0], [3.0, 3.0, 0.5]];
+        assert_eq!(c(y), None);
+    }
+
+    #[test]
+    fn touching_at_a_point_or_edge() {
+        // A vertex exactly on T's interior.
+        let x = [[0.2, 0.2, 0.0], [0.2, 0.2, 1.0], [0.5, 0.0, 1.0]];
+        assert_eq!(c(x), Some(Contact::Touching));
+        // A vertex exactly on T's edge.
+        let y = [[0.5, 0.0, 0.0], [0.5, -1.0, 1.0], [0.5, 1.0, 1.0]];
+        assert_eq!(c(y), Some(Contact::Touching));
+        // Exactly at T's vertex, but not sharing it by index.
+        let z = [[1.0, 0.0, 0.0], [2.0, 0.0, 1.0], [2.0, 1.0, 1.0]];
+        assert_eq!(c(z), Some(Contact::Touching));
+    }
+
+    #[test]
+    fn coplanar_cases() {
+        let over = [[0.2, 0.2, 0.0], [2.0, 0.2, 0.0], [0.2, 2.0, 0.0]];
+        assert_eq!(c(over), Some(Contact::Overlap));
+        let apart = [[2.0, 2.0, 0.0], [3.0, 2.0, 0.0], [2.0, 3.0, 0.0]];
+        assert_eq!(c(apart), None);
+        // T inside a big triangle: no edges meet, containment does.
+        let big = [[-5.0, -5.0, 0.0], [10.0, -5.0, 0.0], [-5.0, 10.0, 0.0]];
+        assert_eq!(c(big), Some(Contact::Overlap));
+    }
+
+    #[test]
+    fn shared_vertex() {
+        // Sharing vertex 0 only, the other one above: fine.
+        let up = [T[0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]];
+        assert_eq!(contact(A, T, [0, 4, 5], up), None);
+        // Sharing vertex 0 and folding into T's plane, overlapping it.
+        let fold = [T[0], [0.5, 0.1, 0.0], [0.0, 0.0, 1.0]];
+        assert_eq!(contact(A, T, [0, 4, 5], fold), Some(Contact::Touching));
+        // Sharing vertex 0 and piercing T elsewhere (camelhead's case).
+        let pierce = [T[0], [0.4, 0.4, -1.0], [0.4, 0.4, 1.0]];
+        assert_eq!(contact(A, T, [0, 4, 5], pierce), Some(Contact::Crossing));
+        // Sharing vertex 0, coplanar, outside T's angle: fine.
+        let beside = [T[0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]];
+        assert_eq!(contact(A, T, [0, 4, 5], beside), None);
+    }
+
+    #[test]
+    fn shared_edge() {
+        let hinge = [T[0], T[1], [0.5, -1.0, 0.5]];
+        assert_eq!(contact(A, T, [0, 1, 5], hinge), None);
+        let flat_other_side = [T[1], T[0], [0.5, -1.0, 0.0]];
+        assert_eq!(contact(A, T, [1, 0, 5], flat_other_side), None);
+        let folded = [T[0], T[1], [0.5, 0.5, 0.0]];
+        assert_eq!(contact(A, T, [0, 1, 5], folded), Some(Contact::Overlap));
+        assert_eq!(
+            contact(A, T, [2, 0, 1], [T[2], T[0], T[1]]),
+            Some(Contact::Duplicate)
+        );
+    }
+}
