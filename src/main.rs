@@ -266,6 +266,7 @@ fn run(args: Vec<OsString>) -> Result<i32, Failure> {
         say!(say, "  Convex hull faces: {}", s.hull_faces);
         say!(say, "");
         say!(say, "  Sorting seconds: {}", s.sort_secs);
+        say!(say, "  Check seconds: {}", s.precheck_secs);
         say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
         say!(say, "  Meshing seconds: {}", s.total_secs);
         let rows = s.table1_rows();

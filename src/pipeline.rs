@@ -75,6 +75,7 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
     };
     let mut warnings = crate::precheck::check(plc)?;
+    let precheck_secs = start.elapsed().as_secs_f64();
     let done = crate::constrained::mesh_plc(plc, &popts)?;
     warnings.extend(done.warnings);
     let ps = done.stats;
@@ -82,6 +83,7 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
         input_points: plc.points.len(),
         output_tets: ps.output_tets,
         delaunay_secs: ps.delaunay_secs,
+        precheck_secs,
         total_secs: start.elapsed().as_secs_f64(),
         plc: Some(ps),
         ..Default::default()

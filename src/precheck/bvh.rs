@@ -94,34 +94,75 @@ impl Bvh {
         id
     }
 
-    /// Calls `f(i, j)` with `i < j` for every pair of boxes that overlap.
+    /// Calls `f(i, j)` with `i < j` for every pair of boxes that overlap, once each: a
+    /// simultaneous descent of the tree against itself, pruning node pairs whose boxes
+    /// are apart.
     pub fn overlapping_pairs(&self, boxes: &[Aabb], mut f: impl FnMut(usize, usize)) {
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack: Vec<u32> = Vec::new();
-        for (i, bi) in boxes.iter().enumerate() {
-            stack.clear();
-            stack.push(0);
-            while let Some(n) = stack.pop() {
-                let node = &self.nodes[n as usize];
-                if !overlap(&node.bbox, bi) {
-                    continue;
-                }
-                if node.leaf {
-                    for &j in &self.order[node.a as usize..node.b as usize] {
-                        let j = j as usize;
-                        if j > i && overlap(bi, &boxes[j]) {
-                            f(i, j);
+        let mut stack: Vec<(u32, u32)> = vec![(0, 0)];
+        let mut emit = |i: u32, j: u32| {
+            let (i, j) = (i.min(j) as usize, i.max(j) as usize);
+            if overlap(&boxes[i], &boxes[j]) {
+                f(i, j);
+            }
+        };
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+            if a == b {
+                if na.leaf {
+                    let items = &self.order[na.a as usize..na.b as usize];
+                    for (k, &i) in items.iter().enumerate() {
+                        for &j in &items[k + 1..] {
+                            emit(i, j);
                         }
                     }
                 } else {
-                    stack.push(node.a);
-                    stack.push(node.b);
+                    stack.push((na.a, na.a));
+                    stack.push((na.b, na.b));
+                    stack.push((na.a, na.b));
+                }
+                continue;
+            }
+            if !overlap(&na.bbox, &nb.bbox) {
+                continue;
+            }
+            match (na.leaf, nb.leaf) {
+                (true, true) => {
+                    for &i in &self.order[na.a as usize..na.b as usize] {
+                        for &j in &self.order[nb.a as usize..nb.b as usize] {
+                            emit(i, j);
+                        }
+                    }
+                }
+                // Descend the inner node, or the larger one when both are inner.
+                (false, true) => {
+                    stack.push((na.a, b));
+                    stack.push((na.b, b));
+                }
+                (true, false) => {
+                    stack.push((a, nb.a));
+                    stack.push((a, nb.b));
+                }
+                (false, false) => {
+                    if volume(&na.bbox) >= volume(&nb.bbox) {
+                        stack.push((na.a, b));
+                        stack.push((na.b, b));
+                    } else {
+                        stack.push((a, nb.a));
+                        stack.push((a, nb.b));
+                    }
                 }
             }
         }
     }
+}
+
+/// A box's size for choosing which node to descend (the sum of its extents, which
+/// unlike the volume does not vanish for flat boxes).
+fn volume(b: &Aabb) -> f64 {
+    (0..3).map(|k| b[1][k] - b[0][k]).sum()
 }
 
 #[cfg(test)]

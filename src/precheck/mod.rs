@@ -288,10 +288,18 @@ fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
 /// triangulated are left out, with a warning pushed to `warnings`.
 pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Vec<Intersection> {
     let surf = surface::triangulate(plc, rep);
-    for (fi, why) in &surf.skipped {
+    if !surf.skipped.is_empty() {
+        let list: Vec<String> = surf
+            .skipped
+            .iter()
+            .take(SHOWN)
+            .map(|(fi, why)| format!("{} ({why})", facet_name(plc, *fi)))
+            .collect();
         warnings.push(format!(
-            "{} could not be triangulated for the intersection check ({why}); it was not checked",
-            facet_name(plc, *fi)
+            "{} facet(s) could not be triangulated and were left out of the intersection check: {}{}",
+            surf.skipped.len(),
+            list.join("; "),
+            more(surf.skipped.len())
         ));
     }
     let pts = &plc.points;

@@ -64,6 +64,15 @@ pub fn triangulate(plc: &Plc, rep: &[u32]) -> Surface {
             });
             continue;
         }
+        if polys.len() == 1 && polys[0].len() == 4 && f.holes.is_empty() {
+            if let Some(pair) = split_quad(&plc.points, &polys[0]) {
+                s.tris.extend(pair.map(|v| SurfaceTri {
+                    v,
+                    facet: fi as u32,
+                }));
+                continue;
+            }
+        }
         if pert.is_empty() {
             pert = (0..plc.points.len() as u32).collect();
         }
@@ -96,4 +105,58 @@ pub fn triangulate(plc: &Plc, rep: &[u32]) -> Surface {
         }
     }
     s
+}
+
+/// The two triangles of a quad that is simple in the projection along its normal's
+/// largest component (split at its reflex corner, if any); `None` for a bow tie or a
+/// degenerate quad, which go to the general triangulation.
+fn split_quad(points: &[[f64; 3]], q: &[u32]) -> Option<[[u32; 3]; 2]> {
+    let n = newell_normal(points, q);
+    let k = (0..3).max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))?;
+    let (ax, ay) = ((k + 1) % 3, (k + 2) % 3);
+    let c = |v: u32| robust::Coord {
+        x: points[v as usize][ax],
+        y: points[v as usize][ay],
+    };
+    let turn: Vec<f64> = (0..4)
+        .map(|i| robust::orient2d(c(q[(i + 3) % 4]), c(q[i]), c(q[(i + 1) % 4])))
+        .collect();
+    let pos = turn.iter().filter(|&&t| t > 0.0).count();
+    let neg = turn.iter().filter(|&&t| t < 0.0).count();
+    // The corner to split from: any corner of a convex quad, the reflex one otherwise.
+    let from = match (pos, neg) {
+        (4, 0) | (0, 4) => 0,
+        (3, 1) => turn.iter().position(|&t| t < 0.0)?,
+        (1, 3) => turn.iter().position(|&t| t > 0.0)?,
+        _ => return None,
+    };
+    let r = |i: usize| q[(from + i) % 4];
+    Some([[r(0), r(1), r(2)], [r(0), r(2), r(3)]])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quads_split_at_their_reflex_corner() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [1.0, 0.5, 0.0], // reflex
+            [0.0, 2.0, 0.0],
+        ];
+        assert_eq!(
+            split_quad(&pts, &[0, 1, 2, 4]),
+            Some([[0, 1, 2], [0, 2, 4]])
+        );
+        assert_eq!(
+            split_quad(&pts, &[0, 1, 2, 3]).map(|t| t[0][0]),
+            Some(3),
+            "a dart is split from its reflex corner"
+        );
+        // A bow tie is left to the general triangulation (which rejects it).
+        assert_eq!(split_quad(&pts, &[0, 2, 1, 4]), None);
+    }
 }
