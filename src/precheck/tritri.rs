@@ -127,27 +127,43 @@ fn coplanar_meet(t: &[Point; 3], u: &[Point; 3], ax: Axes) -> bool {
         || point_in(&t[0], u, ax)
 }
 
+/// Whether the closed segment `pq` meets the closed triangle `t`, all in one plane.
+fn seg_tri_2d(p: &Point, q: &Point, t: &[Point; 3], ax: Axes) -> bool {
+    point_in(p, t, ax)
+        || point_in(q, t, ax)
+        || (0..3).any(|k| seg_seg(p, q, &t[k], &t[(k + 1) % 3], ax))
+}
+
+/// Whether `b`, in the plane of triangle `(v, e, f)`, lies in its closed angle at `v`.
+fn in_angle(v: &Point, b: &Point, e: &Point, f: &Point, ax: Axes) -> bool {
+    let s = o2(v, e, f, ax);
+    o2(v, e, b, ax) * s >= 0 && o2(v, b, f, ax) * s >= 0
+}
+
 /// Whether ray `v → b` (without `v`) enters the closed triangle `(v, e, f)`: `b` is in its
 /// plane and inside its angle at `v`.
 fn ray_enters(v: &Point, b: &Point, e: &Point, f: &Point) -> bool {
     if o3(v, e, f, b) != 0 {
         return false;
     }
-    let Some(ax) = axes_of(v, e, f) else {
-        return false;
-    };
-    let s = o2(v, e, f, ax);
-    o2(v, e, b, ax) * s >= 0 && o2(v, b, f, ax) * s >= 0
+    axes_of(v, e, f).is_some_and(|ax| in_angle(v, b, e, f, ax))
 }
 
 /// Tests two triangles given by vertex ids and coordinates; `None` when they meet only
 /// at shared vertices or along a shared edge (or not at all).
 pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Option<Contact> {
-    let shared: Vec<(usize, usize)> = (0..3)
-        .flat_map(|i| (0..3).map(move |j| (i, j)))
-        .filter(|&(i, j)| ti[i] == ui[j])
-        .collect();
-    let meet = match shared.len() {
+    // Shared vertices as (index in t, index in u); no allocation, this runs per pair.
+    let mut shared = [None; 3];
+    let mut n_shared = 0;
+    for i in 0..3 {
+        for j in 0..3 {
+            if ti[i] == ui[j] && n_shared < 3 {
+                shared[n_shared] = Some((i, j));
+                n_shared += 1;
+            }
+        }
+    }
+    let meet = match n_shared {
         0 => {
             let s: [i8; 3] = std::array::from_fn(|k| o3(&t[0], &t[1], &t[2], &u[k]));
             if s == [1; 3] || s == [-1; 3] {
@@ -166,10 +182,35 @@ pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Opti
         }
         1 => {
             // Rotate both so that the shared vertex comes first.
-            let (i, j) = shared[0];
+            let (i, j) = shared[0].unwrap_or((0, 0));
             let t = [t[i], t[(i + 1) % 3], t[(i + 2) % 3]];
             let u = [u[j], u[(j + 1) % 3], u[(j + 2) % 3]];
             let v = t[0];
+            // One triangle, but for the shared vertex, strictly on one side of the other's
+            // plane: they meet only there. This settles most pairs with two tests.
+            let (sb, sc) = (
+                o3(&u[0], &u[1], &u[2], &t[1]),
+                o3(&u[0], &u[1], &u[2], &t[2]),
+            );
+            if sb * sc > 0 {
+                return None;
+            }
+            let (se, sf) = (
+                o3(&t[0], &t[1], &t[2], &u[1]),
+                o3(&t[0], &t[1], &t[2], &u[2]),
+            );
+            if se * sf > 0 {
+                return None;
+            }
+            if sb == 0 && sc == 0 {
+                // Coplanar: the same tests in 2D, without more exact 3D predicates.
+                let ax = axes_of(&t[0], &t[1], &t[2])?;
+                let meet = seg_tri_2d(&t[1], &t[2], &u, ax)
+                    || seg_tri_2d(&u[1], &u[2], &t, ax)
+                    || (1..3).any(|k| in_angle(&v, &t[k], &u[1], &u[2], ax))
+                    || (1..3).any(|k| in_angle(&v, &u[k], &t[1], &t[2], ax));
+                return meet.then_some(Contact::Overlap);
+            }
             seg_tri(&t[1], &t[2], &u)
                 || seg_tri(&u[1], &u[2], &t)
                 || ray_enters(&v, &t[1], &u[1], &u[2])
@@ -178,9 +219,10 @@ pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Opti
                 || ray_enters(&v, &u[2], &t[1], &t[2])
         }
         2 => {
-            let c = t[(0..3).find(|&i| shared.iter().all(|s| s.0 != i))?];
-            let f = u[(0..3).find(|&j| shared.iter().all(|s| s.1 != j))?];
-            let (a, b) = (t[shared[0].0], t[shared[1].0]);
+            let (s0, s1) = (shared[0]?, shared[1]?);
+            let c = t[(0..3).find(|&i| s0.0 != i && s1.0 != i)?];
+            let f = u[(0..3).find(|&j| s0.1 != j && s1.1 != j)?];
+            let (a, b) = (t[s0.0], t[s1.0]);
             if o3(&a, &b, &c, &f) != 0 {
                 return None;
             }
