@@ -14,6 +14,7 @@ pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
     if opts.plc {
         return run_plc(plc, opts);
     }
+    crate::precheck::check_coordinates(plc)?;
     let start = Instant::now();
     let mut stats = Stats {
         input_points: plc.points.len(),

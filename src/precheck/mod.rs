@@ -91,6 +91,49 @@ fn more(total: usize) -> String {
     }
 }
 
+/// The largest coordinate magnitude accepted: the exact predicates multiply up to five
+/// coordinate differences, which must not overflow.
+pub const MAX_COORD: f64 = 1e40;
+/// The smallest nonzero coordinate magnitude accepted: products of five rounding tails of
+/// differences must not underflow, or the "exact" signs are not exact.
+pub const MIN_COORD: f64 = 1e-40;
+
+/// Checks that every point's coordinates are finite and within the range the exact
+/// predicates handle ([`MIN_COORD`] ≤ |c| ≤ [`MAX_COORD`], or 0). Runs before any meshing.
+pub fn check_coordinates(plc: &Plc) -> Result<(), InputError> {
+    let Some((i, p)) = plc
+        .points
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.iter().any(|&c| out_of_range(c)))
+    else {
+        return Ok(());
+    };
+    let what = if p.iter().all(|c| c.is_finite()) {
+        format!(
+            "a coordinate out of the supported range (0 or {MIN_COORD:e} to {MAX_COORD:e} in \
+             magnitude, where the exact predicates neither overflow nor underflow; scale the model)"
+        )
+    } else {
+        "a non-finite coordinate".to_string()
+    };
+    Err(invalid(
+        plc,
+        format!(
+            "point {} has {what}: ({}, {}, {})",
+            i + plc.first_index,
+            p[0],
+            p[1],
+            p[2]
+        ),
+    ))
+}
+
+/// Whether a coordinate is non-finite or out of the supported range.
+fn out_of_range(c: f64) -> bool {
+    !c.is_finite() || c.abs() > MAX_COORD || (c != 0.0 && c.abs() < MIN_COORD)
+}
+
 /// Runs every check (the intersection test too) and returns the warnings to show; the
 /// first defect found is the error.
 pub fn check(plc: &Plc) -> Result<Vec<String>, InputError> {
@@ -115,20 +158,7 @@ fn invalid(plc: &Plc, msg: String) -> InputError {
 /// vertices); returns the representatives of coincident points.
 pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
     let n = plc.points.len();
-    for (i, p) in plc.points.iter().enumerate() {
-        if p.iter().any(|c| !c.is_finite()) {
-            return Err(invalid(
-                plc,
-                format!(
-                    "point {} has a non-finite coordinate ({}, {}, {})",
-                    i + plc.first_index,
-                    p[0],
-                    p[1],
-                    p[2]
-                ),
-            ));
-        }
-    }
+    check_coordinates(plc)?;
     let seeds = plc
         .holes
         .iter()
@@ -149,11 +179,11 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
             })
         }));
     for (name, p) in seeds {
-        if p.iter().any(|c| !c.is_finite()) {
+        if p.iter().any(|&c| out_of_range(c)) {
             return Err(invalid(
                 plc,
                 format!(
-                    "{name} has a non-finite coordinate ({}, {}, {})",
+                    "{name} has a non-finite or out-of-range coordinate ({}, {}, {})",
                     p[0], p[1], p[2]
                 ),
             ));
