@@ -120,7 +120,7 @@ pub fn check_coordinates(plc: &Plc) -> Result<(), InputError> {
     Err(invalid(
         plc,
         format!(
-            "point {} has {what}: ({}, {}, {})",
+            "point {} has {what}: ({:?}, {:?}, {:?})",
             i + plc.first_index,
             p[0],
             p[1],
