@@ -317,7 +317,7 @@ fn detect_only(
     for line in found.report(plc) {
         say!(say, "{line}");
     }
-    tetcdt::precheck::detect::write(plc, &found.found, prefix, wopts, &mut |p: &Path| {
+    tetcdt::precheck::detect::write(plc, &found, prefix, wopts, &mut |p: &Path| {
         say!(say, "Writing {}.", p.display());
     })?;
     Ok(EXIT_OK)

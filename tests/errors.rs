@@ -225,6 +225,19 @@ fn intersecting_facets_exit_3_naming_the_pairs() {
 }
 
 #[test]
+fn point_on_a_facet_that_does_not_list_it_exits_3() {
+    refused(
+        "stray_point.poly",
+        &["-pQ"],
+        3,
+        &[
+            "stray_point.poly: 1 point(s) lie on a facet without being among its vertices",
+            "point 12 (0.5, 0.5, 1) lies on facet 2 (line 18)",
+        ],
+    );
+}
+
+#[test]
 fn detect_switch_reports_and_writes_the_triangles() {
     let (code, stdout, stderr, files) = run("crossing_facets.poly", &["-d"]);
     assert_eq!(code, 0, "{stderr}");

@@ -94,6 +94,31 @@ impl Bvh {
         id
     }
 
+    /// Calls `f(i)` for every box `i` that overlaps `b`.
+    pub fn query(&self, boxes: &[Aabb], b: &Aabb, mut f: impl FnMut(usize)) {
+        let mut stack: Vec<u32> = if self.nodes.is_empty() {
+            vec![]
+        } else {
+            vec![0]
+        };
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if !overlap(&node.bbox, b) {
+                continue;
+            }
+            if node.leaf {
+                for &i in &self.order[node.a as usize..node.b as usize] {
+                    if overlap(&boxes[i as usize], b) {
+                        f(i as usize);
+                    }
+                }
+            } else {
+                stack.push(node.a);
+                stack.push(node.b);
+            }
+        }
+    }
+
     /// Calls `f(i, j)` with `i < j` for every pair of boxes that overlap, once each: a
     /// simultaneous descent of the tree against itself, pruning node pairs whose boxes
     /// are apart.
@@ -200,5 +225,15 @@ mod tests {
         }
         assert!(!want.is_empty());
         assert_eq!(got, want);
+        for (i, b) in boxes.iter().enumerate().step_by(7) {
+            let mut got = Vec::new();
+            bvh.query(&boxes, b, |j| got.push(j));
+            got.sort_unstable();
+            let want: Vec<usize> = (0..boxes.len())
+                .filter(|&j| overlap(b, &boxes[j]))
+                .collect();
+            assert!(want.contains(&i));
+            assert_eq!(got, want);
+        }
     }
 }

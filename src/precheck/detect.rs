@@ -2,7 +2,9 @@
 //! the intersecting triangles (`<prefix>.node`, `<prefix>.face`), without meshing. As in
 //! TetGen, nothing is written when no facets intersect, and both cases exit with 0.
 
-use super::{check_elements, intersection_line, intersections, Intersection};
+use super::{
+    check_elements, intersection_line, intersections, stray_line, Intersection, StrayVertex,
+};
 use crate::error::{Error, InputError};
 use crate::io::write::{output_path, write_kind, FileKind, WriteOptions};
 use crate::output::MeshOut;
@@ -16,6 +18,8 @@ use std::path::{Path, PathBuf};
 pub struct Detected {
     /// The intersecting pairs of facets.
     pub found: Vec<Intersection>,
+    /// Points lying on facets that do not list them.
+    pub strays: Vec<StrayVertex>,
     /// Warnings (facets that could not be checked).
     pub warnings: Vec<String>,
 }
@@ -23,18 +27,30 @@ pub struct Detected {
 impl Detected {
     /// The report, one line per pair, as printed by `-d`.
     pub fn report(&self, plc: &Plc) -> Vec<String> {
-        if self.found.is_empty() {
-            return vec!["No faces are intersecting.".into()];
-        }
         let mut lines: Vec<String> = self
             .found
             .iter()
             .map(|x| format!("  {}", intersection_line(plc, x)))
+            .chain(
+                self.strays
+                    .iter()
+                    .map(|s| format!("  {}", stray_line(plc, s))),
+            )
             .collect();
-        lines.push(format!(
-            "Found {} pair(s) of intersecting facets.",
-            self.found.len()
-        ));
+        if self.found.is_empty() {
+            lines.push("No faces are intersecting.".into());
+        } else {
+            lines.push(format!(
+                "Found {} pair(s) of intersecting facets.",
+                self.found.len()
+            ));
+        }
+        if !self.strays.is_empty() {
+            lines.push(format!(
+                "Found {} point(s) on facets that do not list them.",
+                self.strays.len()
+            ));
+        }
         lines
     }
 }
@@ -44,15 +60,22 @@ impl Detected {
 pub fn detect(plc: &Plc) -> Result<Detected, InputError> {
     let rep = check_elements(plc)?;
     let mut warnings = Vec::new();
-    let found = intersections(plc, &rep, &mut warnings);
-    Ok(Detected { found, warnings })
+    let (found, strays) = intersections(plc, &rep, &mut warnings);
+    Ok(Detected {
+        found,
+        strays,
+        warnings,
+    })
 }
 
-/// The intersecting triangles, once each, by facet, with their facet markers.
-pub fn faces_of(plc: &Plc, found: &[Intersection]) -> Vec<([u32; 3], i32)> {
-    let mut faces: Vec<(usize, [u32; 3])> = found
+/// The intersecting triangles (and those with stray points), once each, by facet, with
+/// their facet markers.
+pub fn faces_of(plc: &Plc, d: &Detected) -> Vec<([u32; 3], i32)> {
+    let mut faces: Vec<(usize, [u32; 3])> = d
+        .found
         .iter()
         .flat_map(|x| [(x.facets[0], x.tris[0]), (x.facets[1], x.tris[1])])
+        .chain(d.strays.iter().map(|s| (s.facet, s.tri)))
         .collect();
     faces.sort_unstable();
     faces.dedup();
@@ -64,15 +87,15 @@ pub fn faces_of(plc: &Plc, found: &[Intersection]) -> Vec<([u32; 3], i32)> {
 
 /// Writes `<prefix>.node` (the input points) and `<prefix>.face` (the intersecting
 /// triangles) atomically: both go to temporary names first and are renamed when complete.
-/// Writes nothing when `found` is empty. Returns the paths written.
+/// Writes nothing when nothing was found. Returns the paths written.
 pub fn write(
     plc: &Plc,
-    found: &[Intersection],
+    d: &Detected,
     prefix: &Path,
     w: &WriteOptions,
     on_file: &mut dyn FnMut(&Path),
 ) -> Result<Vec<PathBuf>, Error> {
-    if found.is_empty() {
+    if d.found.is_empty() && d.strays.is_empty() {
         return Ok(Vec::new());
     }
     let mesh = MeshOut {
@@ -80,7 +103,7 @@ pub fn write(
         num_point_attrs: plc.num_point_attrs,
         point_attrs: plc.point_attrs.clone(),
         point_markers: plc.point_markers.clone(),
-        subfaces: faces_of(plc, found),
+        subfaces: faces_of(plc, d),
         plc_mode: true,
         first_index: plc.first_index,
         ..Default::default()

@@ -36,6 +36,18 @@ pub struct Intersection {
     pub kind: Contact,
 }
 
+/// A point that lies on a facet without being one of its vertices (nor a vertex of any
+/// polygon with an area, which the triangle tests cover).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StrayVertex {
+    /// The point (0-based representative).
+    pub point: u32,
+    /// The facet it lies on (0-based).
+    pub facet: usize,
+    /// The facet's triangle it lies on.
+    pub tri: [u32; 3],
+}
+
 /// For each point, the lowest-indexed point with exactly equal coordinates.
 pub fn representatives(points: &[[f64; 3]]) -> Vec<u32> {
     let mut first: FxHashMap<[u64; 3], u32> = FxHashMap::default();
@@ -140,9 +152,12 @@ pub fn check(plc: &Plc) -> Result<Vec<String>, InputError> {
     let rep = check_elements(plc)?;
     check_duplicates(plc, &rep)?;
     let mut warnings = Vec::new();
-    let found = intersections(plc, &rep, &mut warnings);
+    let (found, strays) = intersections(plc, &rep, &mut warnings);
     if !found.is_empty() {
         return Err(invalid(plc, intersection_message(plc, &found)));
+    }
+    if !strays.is_empty() {
+        return Err(invalid(plc, stray_message(plc, &strays)));
     }
     Ok(warnings)
 }
@@ -314,9 +329,14 @@ fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
 }
 
 /// Every pair of input facets that meet other than at shared vertices and edges, at the
-/// first pair of their triangles found, sorted by facets. Facets that cannot be
-/// triangulated are left out, with a warning pushed to `warnings`.
-pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Vec<Intersection> {
+/// first pair of their triangles found, sorted by facets; and every point that is no
+/// vertex of a triangle but lies on a facet whose polygons do not list it. Facets that
+/// cannot be triangulated are left out, with a warning pushed to `warnings`.
+pub fn intersections(
+    plc: &Plc,
+    rep: &[u32],
+    warnings: &mut Vec<String>,
+) -> (Vec<Intersection>, Vec<StrayVertex>) {
     let surf = surface::triangulate(plc, rep);
     if !surf.skipped.is_empty() {
         let list: Vec<String> = surf
@@ -371,7 +391,91 @@ pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Vec<
     });
     let mut out: Vec<Intersection> = found.into_values().collect();
     out.sort_by_key(|x| x.facets);
+    (out, stray_vertices(plc, rep, &surf, &boxes, &bvh))
+}
+
+/// The points that are no triangle's vertex (loose points, and vertices of segments and
+/// isolated vertices only) and lie on a triangle of a facet that does not list them.
+fn stray_vertices(
+    plc: &Plc,
+    rep: &[u32],
+    surf: &surface::Surface,
+    boxes: &[Aabb],
+    bvh: &Bvh,
+) -> Vec<StrayVertex> {
+    let mut on_triangle = vec![false; plc.points.len()];
+    for t in &surf.tris {
+        for &v in &t.v {
+            on_triangle[v as usize] = true;
+        }
+    }
+    // The facets that list each point (as a vertex of any polygon); only points off the
+    // triangles are looked up, so only they are recorded.
+    let mut listed: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+    for (fi, f) in plc.facets.iter().enumerate() {
+        for p in &f.polygons {
+            for &v in p {
+                let r = rep[v as usize];
+                if !on_triangle[r as usize] {
+                    listed.entry(r).or_default().push(fi);
+                }
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (v, &r) in rep.iter().enumerate() {
+        if r as usize != v || on_triangle[v] {
+            continue;
+        }
+        let p = plc.points[v];
+        let own = listed.get(&r).map(|x| x.as_slice()).unwrap_or(&[]);
+        let mut hit: Option<usize> = None;
+        bvh.query(boxes, &[p, p], |i| {
+            let t = &surf.tris[i];
+            if hit.is_some_and(|h| surf.tris[h].facet <= t.facet)
+                || own.contains(&(t.facet as usize))
+            {
+                return;
+            }
+            if tritri::point_on(&p, &t.v.map(|x| plc.points[x as usize])) {
+                hit = Some(i);
+            }
+        });
+        if let Some(i) = hit {
+            out.push(StrayVertex {
+                point: r,
+                facet: surf.tris[i].facet as usize,
+                tri: surf.tris[i].v,
+            });
+        }
+    }
     out
+}
+
+/// The error text for points lying on facets that do not list them.
+pub fn stray_message(plc: &Plc, strays: &[StrayVertex]) -> String {
+    let list: Vec<String> = strays
+        .iter()
+        .take(SHOWN)
+        .map(|s| stray_line(plc, s))
+        .collect();
+    format!(
+        "{} point(s) lie on a facet without being among its vertices (add them to the \
+         facet's polygons, or move them):\n  {}{}",
+        strays.len(),
+        list.join("\n  "),
+        more(strays.len())
+    )
+}
+
+/// One line per stray point, for reports.
+pub fn stray_line(plc: &Plc, s: &StrayVertex) -> String {
+    format!(
+        "point {} lies on {} (triangle {})",
+        point_name(plc, s.point),
+        facet_name(plc, s.facet),
+        tri_name(plc, s.tri)
+    )
 }
 
 /// One line per intersecting pair, for reports.

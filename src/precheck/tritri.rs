@@ -149,6 +149,12 @@ fn ray_enters(v: &Point, b: &Point, e: &Point, f: &Point) -> bool {
     axes_of(v, e, f).is_some_and(|ax| in_angle(v, b, e, f, ax))
 }
 
+/// Whether point `p` lies on the closed triangle `t` (in its plane, inside or on its boundary).
+pub fn point_on(p: &Point, t: &[Point; 3]) -> bool {
+    o3(&t[0], &t[1], &t[2], p) == 0
+        && axes_of(&t[0], &t[1], &t[2]).is_some_and(|ax| point_in(p, t, ax))
+}
+
 /// Tests two triangles given by vertex ids and coordinates; `None` when they meet only
 /// at shared vertices or along a shared edge (or not at all).
 pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Option<Contact> {
