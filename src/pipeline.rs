@@ -9,11 +9,28 @@ use crate::stats::Stats;
 use crate::Meshed;
 use std::time::Instant;
 
-/// Runs the pipeline on `plc` as `opts` asks.
+/// Runs the pipeline on `plc` as `opts` asks. A model without volume (all points
+/// coplanar) is an invalid input, named by its file.
 pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
-    if opts.plc {
-        return run_plc(plc, opts);
-    }
+    let r = if opts.plc {
+        run_plc(plc, opts)
+    } else {
+        run_points(plc, opts)
+    };
+    r.map_err(|e| match e {
+        Error::Mesh(MeshError::Degenerate(msg)) if !plc.source.as_os_str().is_empty() => {
+            crate::error::InputError::Invalid {
+                file: plc.source.clone(),
+                msg,
+            }
+            .into()
+        }
+        e => e,
+    })
+}
+
+/// The Delaunay tetrahedralization of a point set.
+fn run_points(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
     crate::precheck::check_coordinates(plc)?;
     let start = Instant::now();
     let mut stats = Stats {
