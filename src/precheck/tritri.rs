@@ -161,9 +161,9 @@ pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Opti
     // Shared vertices as (index in t, index in u); no allocation, this runs per pair.
     let mut shared = [None; 3];
     let mut n_shared = 0;
-    for i in 0..3 {
-        for j in 0..3 {
-            if ti[i] == ui[j] && n_shared < 3 {
+    for (i, a) in ti.iter().enumerate() {
+        for (j, b) in ui.iter().enumerate() {
+            if a == b && n_shared < 3 {
                 shared[n_shared] = Some((i, j));
                 n_shared += 1;
             }
