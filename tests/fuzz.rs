@@ -12,7 +12,7 @@
 //! Every run happens on a worker thread with a deadline: a panic or a hang fails the test
 //! with the input that caused it. Errors must be of the right kind: never an I/O error
 //! for a readable file, never an internal error. `TETCDT_FUZZ_CASES` sets the number of
-//! cases per test (default 200, a few seconds each).
+//! cases per test (default 1000, a few seconds each).
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -31,7 +31,7 @@ fn cases() -> u32 {
     std::env::var("TETCDT_FUZZ_CASES")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(200)
+        .unwrap_or(1000)
 }
 
 /// Runs `f` on a worker thread; a panic or a run past the deadline is an error naming `what`.

@@ -316,6 +316,43 @@ mod tests {
         assert_eq!(contact(A, T, [0, 4, 5], beside), None);
     }
 
+    /// On random triangles of a 3×3×3 grid (so that degenerate contacts abound), the
+    /// verdict does not depend on the order of the two triangles, on the rotation or the
+    /// orientation of either, and the kind is the same both ways.
+    #[test]
+    fn verdict_is_symmetric_and_order_free() {
+        let mut s = 7u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as u32 % 27
+        };
+        let pt = |i: u32| [(i % 3) as f64, (i / 3 % 3) as f64, (i / 9) as f64];
+        let mut seen = [0usize; 5];
+        for _ in 0..20000 {
+            let t = [next(), next(), next()];
+            let u = [next(), next(), next()];
+            let tp = t.map(pt);
+            let up = u.map(pt);
+            if axes_of(&tp[0], &tp[1], &tp[2]).is_none()
+                || axes_of(&up[0], &up[1], &up[2]).is_none()
+            {
+                continue;
+            }
+            let c = contact(t, tp, u, up);
+            seen[c.map_or(4, |k| k as usize)] += 1;
+            assert_eq!(contact(u, up, t, tp), c, "{t:?} {u:?}");
+            let rot = |a: [u32; 3]| [a[1], a[2], a[0]];
+            let rev = |a: [u32; 3]| [a[0], a[2], a[1]];
+            for (t2, u2) in [(rot(t), u), (t, rev(u)), (rev(rot(t)), rot(rot(u)))] {
+                assert_eq!(contact(t2, t2.map(pt), u2, u2.map(pt)), c, "{t:?} {u:?}");
+            }
+        }
+        // Every kind of contact occurred, and so did no contact.
+        assert!(seen.iter().all(|&k| k > 0), "{seen:?}");
+    }
+
     #[test]
     fn shared_edge() {
         let hinge = [T[0], T[1], [0.5, -1.0, 0.5]];
