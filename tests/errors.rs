@@ -225,6 +225,19 @@ fn intersecting_facets_exit_3_naming_the_pairs() {
 }
 
 #[test]
+fn segment_through_a_facet_exits_3() {
+    refused(
+        "crossing_segment.poly",
+        &["-pQ"],
+        3,
+        &[
+            "1 segment(s) meet a facet other than at a shared vertex",
+            "segment (9, 10) of facet 7 (line 26) and facet 2 (line 16) (crossing)",
+        ],
+    );
+}
+
+#[test]
 fn point_on_a_facet_that_does_not_list_it_exits_3() {
     refused(
         "stray_point.poly",

@@ -3,7 +3,8 @@
 //! TetGen, nothing is written when no facets intersect, and both cases exit with 0.
 
 use super::{
-    check_elements, intersection_line, intersections, stray_line, Intersection, StrayVertex,
+    check_elements, intersection_line, intersections, segment_line, stray_line, Intersection,
+    SegmentHit, StrayVertex,
 };
 use crate::error::{Error, InputError};
 use crate::io::write::{output_path, write_kind, FileKind, WriteOptions};
@@ -18,6 +19,8 @@ use std::path::{Path, PathBuf};
 pub struct Detected {
     /// The intersecting pairs of facets.
     pub found: Vec<Intersection>,
+    /// Segments meeting facets.
+    pub segments: Vec<SegmentHit>,
     /// Points lying on facets that do not list them.
     pub strays: Vec<StrayVertex>,
     /// Warnings (facets that could not be checked).
@@ -32,6 +35,11 @@ impl Detected {
             .iter()
             .map(|x| format!("  {}", intersection_line(plc, x)))
             .chain(
+                self.segments
+                    .iter()
+                    .map(|h| format!("  {}", segment_line(plc, h))),
+            )
+            .chain(
                 self.strays
                     .iter()
                     .map(|s| format!("  {}", stray_line(plc, s))),
@@ -43,6 +51,12 @@ impl Detected {
             lines.push(format!(
                 "Found {} pair(s) of intersecting facets.",
                 self.found.len()
+            ));
+        }
+        if !self.segments.is_empty() {
+            lines.push(format!(
+                "Found {} segment(s) meeting facets.",
+                self.segments.len()
             ));
         }
         if !self.strays.is_empty() {
@@ -60,10 +74,11 @@ impl Detected {
 pub fn detect(plc: &Plc) -> Result<Detected, InputError> {
     let rep = check_elements(plc)?;
     let mut warnings = Vec::new();
-    let (found, strays) = intersections(plc, &rep, &mut warnings);
+    let f = intersections(plc, &rep, &mut warnings);
     Ok(Detected {
-        found,
-        strays,
+        found: f.pairs,
+        segments: f.segments,
+        strays: f.strays,
         warnings,
     })
 }
@@ -75,6 +90,7 @@ pub fn faces_of(plc: &Plc, d: &Detected) -> Vec<([u32; 3], i32)> {
         .found
         .iter()
         .flat_map(|x| [(x.facets[0], x.tris[0]), (x.facets[1], x.tris[1])])
+        .chain(d.segments.iter().map(|h| (h.facet, h.tri)))
         .chain(d.strays.iter().map(|s| (s.facet, s.tri)))
         .collect();
     faces.sort_unstable();
@@ -95,7 +111,7 @@ pub fn write(
     w: &WriteOptions,
     on_file: &mut dyn FnMut(&Path),
 ) -> Result<Vec<PathBuf>, Error> {
-    if d.found.is_empty() && d.strays.is_empty() {
+    if d.found.is_empty() && d.segments.is_empty() && d.strays.is_empty() {
         return Ok(Vec::new());
     }
     let mesh = MeshOut {

@@ -36,6 +36,39 @@ pub struct Intersection {
     pub kind: Contact,
 }
 
+/// A segment (2-vertex polygon) that meets a facet other than at a shared vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegmentHit {
+    /// The segment's vertices (0-based representatives).
+    pub seg: [u32; 2],
+    /// The facet the segment belongs to (0-based).
+    pub seg_facet: usize,
+    /// The facet it meets (0-based), at one of its triangles.
+    pub facet: usize,
+    /// That triangle.
+    pub tri: [u32; 3],
+    /// How they meet.
+    pub kind: Contact,
+}
+
+/// Everything the intersection test found.
+#[derive(Clone, Debug, Default)]
+pub struct Findings {
+    /// Pairs of facets that intersect, sorted by facets.
+    pub pairs: Vec<Intersection>,
+    /// Segments that meet facets.
+    pub segments: Vec<SegmentHit>,
+    /// Points lying on facets that do not list them.
+    pub strays: Vec<StrayVertex>,
+}
+
+impl Findings {
+    /// Whether nothing was found.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty() && self.segments.is_empty() && self.strays.is_empty()
+    }
+}
+
 /// A point that lies on a facet without being one of its vertices (nor a vertex of any
 /// polygon with an area, which the triangle tests cover).
 #[derive(Clone, Debug, PartialEq)]
@@ -152,12 +185,15 @@ pub fn check(plc: &Plc) -> Result<Vec<String>, InputError> {
     let rep = check_elements(plc)?;
     check_duplicates(plc, &rep)?;
     let mut warnings = Vec::new();
-    let (found, strays) = intersections(plc, &rep, &mut warnings);
-    if !found.is_empty() {
-        return Err(invalid(plc, intersection_message(plc, &found)));
+    let found = intersections(plc, &rep, &mut warnings);
+    if !found.pairs.is_empty() {
+        return Err(invalid(plc, intersection_message(plc, &found.pairs)));
     }
-    if !strays.is_empty() {
-        return Err(invalid(plc, stray_message(plc, &strays)));
+    if !found.segments.is_empty() {
+        return Err(invalid(plc, segment_message(plc, &found.segments)));
+    }
+    if !found.strays.is_empty() {
+        return Err(invalid(plc, stray_message(plc, &found.strays)));
     }
     Ok(warnings)
 }
@@ -329,14 +365,11 @@ fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
 }
 
 /// Every pair of input facets that meet other than at shared vertices and edges, at the
-/// first pair of their triangles found, sorted by facets; and every point that is no
+/// first pair of their triangles found, sorted by facets; every segment (2-vertex polygon)
+/// that meets another facet other than at a shared vertex; and every point that is no
 /// vertex of a triangle but lies on a facet whose polygons do not list it. Facets that
 /// cannot be triangulated are left out, with a warning pushed to `warnings`.
-pub fn intersections(
-    plc: &Plc,
-    rep: &[u32],
-    warnings: &mut Vec<String>,
-) -> (Vec<Intersection>, Vec<StrayVertex>) {
+pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Findings {
     let surf = surface::triangulate(plc, rep);
     if !surf.skipped.is_empty() {
         let list: Vec<String> = surf
@@ -389,9 +422,67 @@ pub fn intersections(
             );
         }
     });
-    let mut out: Vec<Intersection> = found.into_values().collect();
-    out.sort_by_key(|x| x.facets);
-    (out, stray_vertices(plc, rep, &surf, &boxes, &bvh))
+    let mut pairs: Vec<Intersection> = found.into_values().collect();
+    pairs.sort_by_key(|x| x.facets);
+    let mut segments = Vec::new();
+    for &(s, sf) in &surf.segments {
+        let sp = s.map(|v| pts[v as usize]);
+        let bb: Aabb = [
+            std::array::from_fn(|k| sp[0][k].min(sp[1][k])),
+            std::array::from_fn(|k| sp[0][k].max(sp[1][k])),
+        ];
+        let mut hit: Option<SegmentHit> = None;
+        bvh.query(&boxes, &bb, |i| {
+            let t = &surf.tris[i];
+            if t.facet == sf || hit.as_ref().is_some_and(|h| h.facet <= t.facet as usize) {
+                return;
+            }
+            if let Some(kind) = tritri::seg_contact(s, sp, t.v, corners(t.v)) {
+                hit = Some(SegmentHit {
+                    seg: s,
+                    seg_facet: sf as usize,
+                    facet: t.facet as usize,
+                    tri: t.v,
+                    kind,
+                });
+            }
+        });
+        segments.extend(hit);
+    }
+    Findings {
+        pairs,
+        segments,
+        strays: stray_vertices(plc, rep, &surf, &boxes, &bvh),
+    }
+}
+
+/// The error text for segments meeting facets.
+pub fn segment_message(plc: &Plc, hits: &[SegmentHit]) -> String {
+    let list: Vec<String> = hits
+        .iter()
+        .take(SHOWN)
+        .map(|h| segment_line(plc, h))
+        .collect();
+    format!(
+        "{} segment(s) meet a facet other than at a shared vertex:\n  {}{}",
+        hits.len(),
+        list.join("\n  "),
+        more(hits.len())
+    )
+}
+
+/// One line per segment meeting a facet, for reports.
+pub fn segment_line(plc: &Plc, h: &SegmentHit) -> String {
+    let b = plc.first_index;
+    format!(
+        "segment ({}, {}) of {} and {} ({}) at triangle {}",
+        h.seg[0] as usize + b,
+        h.seg[1] as usize + b,
+        facet_name(plc, h.seg_facet),
+        facet_name(plc, h.facet),
+        h.kind.name(),
+        tri_name(plc, h.tri)
+    )
 }
 
 /// The points that are no triangle's vertex (loose points, and vertices of segments and

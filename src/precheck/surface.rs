@@ -20,6 +20,8 @@ pub struct SurfaceTri {
 pub struct Surface {
     /// Triangles of all facets, facet by facet.
     pub tris: Vec<SurfaceTri>,
+    /// 2-vertex polygons (segments floating in a facet): vertices and facet.
+    pub segments: Vec<([u32; 2], u32)>,
     /// Facets left out of the check: (0-based facet, why).
     pub skipped: Vec<(usize, String)>,
 }
@@ -51,6 +53,9 @@ pub fn triangulate(plc: &Plc, rep: &[u32]) -> Surface {
             .map(|p| clean_ring(p, rep))
             .filter(|p| !p.is_empty())
             .collect();
+        for p in polys.iter().filter(|p| p.len() == 2) {
+            s.segments.push(([p[0], p[1]], fi as u32));
+        }
         let rings = polys.iter().filter(|p| p.len() >= 3).count();
         if rings == 0 {
             continue;

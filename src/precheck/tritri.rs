@@ -149,6 +149,36 @@ fn ray_enters(v: &Point, b: &Point, e: &Point, f: &Point) -> bool {
     axes_of(v, e, f).is_some_and(|ax| in_angle(v, b, e, f, ax))
 }
 
+/// Tests a segment (2-vertex polygon) against a triangle, by vertex ids and coordinates;
+/// `None` when they meet only at a shared vertex, or the segment is an edge of it.
+pub fn seg_contact(si: [u32; 2], s: [Point; 2], ti: [u32; 3], t: [Point; 3]) -> Option<Contact> {
+    let at = |v: u32| ti.iter().position(|&x| x == v);
+    match (at(si[0]), at(si[1])) {
+        (Some(_), Some(_)) => None,
+        (Some(i), None) | (None, Some(i)) => {
+            let q = if at(si[0]).is_some() { s[1] } else { s[0] };
+            let r = [t[i], t[(i + 1) % 3], t[(i + 2) % 3]];
+            if !ray_enters(&r[0], &q, &r[1], &r[2]) {
+                return None;
+            }
+            Some(Contact::Overlap)
+        }
+        (None, None) => {
+            if !seg_tri(&s[0], &s[1], &t) {
+                return None;
+            }
+            let coplanar = (0..2).all(|k| o3(&t[0], &t[1], &t[2], &s[k]) == 0);
+            Some(if coplanar {
+                Contact::Overlap
+            } else if seg_crosses_tri(&s[0], &s[1], &t) {
+                Contact::Crossing
+            } else {
+                Contact::Touching
+            })
+        }
+    }
+}
+
 /// Whether point `p` lies on the closed triangle `t` (in its plane, inside or on its boundary).
 pub fn point_on(p: &Point, t: &[Point; 3]) -> bool {
     o3(&t[0], &t[1], &t[2], p) == 0
@@ -351,6 +381,27 @@ mod tests {
         }
         // Every kind of contact occurred, and so did no contact.
         assert!(seen.iter().all(|&k| k > 0), "{seen:?}");
+    }
+
+    #[test]
+    fn segments_against_a_triangle() {
+        let s = |a: [f64; 3], b: [f64; 3]| [a, b];
+        // Through the interior, beside it, ending on it, lying in it.
+        let through = s([0.2, 0.2, -1.0], [0.2, 0.2, 1.0]);
+        assert_eq!(seg_contact([7, 8], through, A, T), Some(Contact::Crossing));
+        let beside = s([2.0, 2.0, -1.0], [2.0, 2.0, 1.0]);
+        assert_eq!(seg_contact([7, 8], beside, A, T), None);
+        let ending = s([0.2, 0.2, 0.0], [0.2, 0.2, 1.0]);
+        assert_eq!(seg_contact([7, 8], ending, A, T), Some(Contact::Touching));
+        let inside = s([0.1, 0.1, 0.0], [0.3, 0.1, 0.0]);
+        assert_eq!(seg_contact([7, 8], inside, A, T), Some(Contact::Overlap));
+        // From a vertex of T: upwards is fine, along T's plane into T is not.
+        assert_eq!(seg_contact([0, 8], s(T[0], [0.0, 0.0, 1.0]), A, T), None);
+        assert_eq!(
+            seg_contact([0, 8], s(T[0], [0.2, 0.2, 0.0]), A, T),
+            Some(Contact::Overlap)
+        );
+        assert_eq!(seg_contact([0, 1], s(T[0], T[1]), A, T), None);
     }
 
     #[test]
