@@ -255,23 +255,18 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
                     ),
                 ));
             }
-            if poly.len() >= 3 {
-                let mut seen: FxHashMap<u32, usize> = FxHashMap::default();
-                for (k, &v) in poly.iter().enumerate() {
-                    if let Some(j) = seen.insert(v, k) {
-                        return Err(invalid(
-                            plc,
-                            format!(
-                                "{}: vertex {} is repeated (positions {} and {} of {})",
-                                at(),
-                                v as usize + plc.first_index,
-                                j + 1,
-                                k + 1,
-                                poly.len()
-                            ),
-                        ));
-                    }
-                }
+            if let Some((j, k)) = repeated(poly) {
+                return Err(invalid(
+                    plc,
+                    format!(
+                        "{}: vertex {} is repeated (positions {} and {} of {})",
+                        at(),
+                        poly[k] as usize + plc.first_index,
+                        j + 1,
+                        k + 1,
+                        poly.len()
+                    ),
+                ));
             }
         }
     }
@@ -345,6 +340,23 @@ pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
         ));
     }
     Ok(())
+}
+
+/// The first repeated vertex of a polygon of 3 or more vertices, as the positions
+/// `(first, repeat)`; a 2-vertex polygon `[v, v]` is a degenerate segment, not a repeat.
+fn repeated(poly: &[u32]) -> Option<(usize, usize)> {
+    if poly.len() < 3 {
+        return None;
+    }
+    if poly.len() <= 16 {
+        // Small polygons (nearly all): no allocation.
+        return (1..poly.len())
+            .find_map(|k| poly[..k].iter().position(|&v| v == poly[k]).map(|j| (j, k)));
+    }
+    let mut seen: FxHashMap<u32, usize> = FxHashMap::default();
+    poly.iter()
+        .enumerate()
+        .find_map(|(k, &v)| seen.insert(v, k).map(|j| (j, k)))
 }
 
 /// Exact test: are all vertices of the ring on one line? (Every axis projection has zero
@@ -643,4 +655,46 @@ pub fn empty_domain_message(plc: &Plc) -> String {
         list.join("; "),
         more(open.len())
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn repeated_vertices_small_and_large() {
+        assert_eq!(repeated(&[1, 2, 3]), None);
+        assert_eq!(repeated(&[4, 4]), None);
+        assert_eq!(repeated(&[1, 2, 3, 2]), Some((1, 3)));
+        let mut big: Vec<u32> = (0..40).collect();
+        assert_eq!(repeated(&big), None);
+        big.push(17);
+        assert_eq!(repeated(&big), Some((17, 40)));
+    }
+
+    #[test]
+    fn representatives_merge_equal_points_and_signed_zeros() {
+        let pts = [
+            [0.0, 1.0, 2.0],
+            [-0.0, 1.0, 2.0],
+            [0.0, 1.0, 2.5],
+            [0.0, 1.0, 2.5],
+        ];
+        assert_eq!(representatives(&pts), vec![0, 0, 2, 2]);
+    }
+
+    #[test]
+    fn coordinate_range() {
+        let mut plc = Plc::from_points(vec![[0.0, 1e-40, -1e40]], 1);
+        assert!(check_coordinates(&plc).is_ok());
+        plc.points[0][1] = 1e-41;
+        let e = check_coordinates(&plc).unwrap_err().to_string();
+        assert!(
+            e.contains("point 1 has a coordinate out of the supported range"),
+            "{e}"
+        );
+        plc.points[0][1] = f64::NAN;
+        let e = check_coordinates(&plc).unwrap_err().to_string();
+        assert!(e.contains("point 1 has a non-finite coordinate"), "{e}");
+    }
 }
