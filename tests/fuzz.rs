@@ -431,3 +431,92 @@ fn perturbed_cubes_mesh_and_open_ones_are_refused() {
         })
         .unwrap();
 }
+
+/// The unit cube scaled by `s` and moved by `o`, its points numbered after `base`.
+fn boxed(o: [f64; 3], s: f64, base: u32) -> (Vec<[f64; 3]>, Vec<Facet>) {
+    let c = cube();
+    let points = c
+        .points
+        .iter()
+        .map(|p| std::array::from_fn(|k| o[k] + s * p[k]))
+        .collect();
+    let facets = c
+        .facets
+        .into_iter()
+        .map(|mut f| {
+            f.polygons[0].iter_mut().for_each(|v| *v += base);
+            f
+        })
+        .collect();
+    (points, facets)
+}
+
+/// Two boxes: the unit cube and one at odd multiples of 1/8 (so that no vertices, edges
+/// or face planes coincide). Their surfaces meet exactly when the closed boxes meet and
+/// neither lies inside the other: then the PLC must be refused as intersecting, else it
+/// must mesh into a valid mesh.
+#[test]
+fn two_boxes_are_refused_exactly_when_they_intersect() {
+    let meshed = std::sync::Arc::new(AtomicUsize::new(0));
+    let refused = std::sync::Arc::new(AtomicUsize::new(0));
+    let (m2, r2) = (meshed.clone(), refused.clone());
+    let mut runner = TestRunner::new(Config {
+        cases: cases() / 4,
+        failure_persistence: None,
+        ..Config::default()
+    });
+    let strategy = (proptest::array::uniform3(-6i32..6), 1i32..12);
+    runner
+        .run(&strategy, |(o, s)| {
+            // Corner at odd multiples of 1/8, side a multiple of 1/4.
+            let o = o.map(|k| (2 * k + 1) as f64 / 8.0);
+            let s = s as f64 / 4.0;
+            let (mut points, mut facets) = boxed([0.0; 3], 1.0, 0);
+            let (p2, f2) = boxed(o, s, 8);
+            points.extend(p2);
+            facets.extend(f2);
+            let plc = Plc {
+                points,
+                facets,
+                source: "boxes.poly".into(),
+                ..Default::default()
+            };
+            let (lo, hi) = (o, o.map(|x| x + s));
+            let meet = (0..3).all(|k| lo[k] <= 1.0 && hi[k] >= 0.0);
+            let b_in_a = (0..3).all(|k| lo[k] > 0.0 && hi[k] < 1.0);
+            let a_in_b = (0..3).all(|k| lo[k] < 0.0 && hi[k] > 1.0);
+            let crossing = meet && !b_in_a && !a_in_b;
+            let what = format!("box at {o:?} side {s}");
+            let p2 = plc.clone();
+            let r = guarded(what.clone(), move || {
+                let opts = Options {
+                    plc: true,
+                    quiet: true,
+                    ..Default::default()
+                };
+                tetcdt::tetrahedralize(&p2, &opts)
+            })?;
+            match r {
+                Ok(m) => {
+                    m2.fetch_add(1, Relaxed);
+                    prop_assert!(!crossing, "meshed crossing boxes: {}", what);
+                    if let Err(p) = tetcdt::check::check_mesh(&plc, &m.mesh) {
+                        return Err(TestCaseError::fail(format!("invalid mesh {p:?} of {what}")));
+                    }
+                }
+                Err(e) => {
+                    r2.fetch_add(1, Relaxed);
+                    let msg = e.to_string();
+                    prop_assert!(crossing, "refused {}: {}", what, msg);
+                    prop_assert!(msg.contains("pair(s) of facets intersect"), "{}", msg);
+                    prop_assert_eq!(e.exit_code(), 3);
+                }
+            }
+            Ok(())
+        })
+        .unwrap();
+    // Both outcomes occurred (the proportions depend on the strategy's ranges).
+    let (m, r) = (meshed.load(Relaxed), refused.load(Relaxed));
+    eprintln!("two boxes: {m} meshed, {r} refused");
+    assert!(m > 0 && r > 0, "{m} meshed, {r} refused");
+}
