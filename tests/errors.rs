@@ -317,7 +317,32 @@ fn steiner_bound_exits_1_with_the_reason() {
     assert!(stderr.contains("more than 1 Steiner points"), "{stderr}");
     assert!(stderr.contains("-S"), "{stderr}");
     assert_eq!(listing(dir.path()), ["s.off"]);
-    // With room for them, the same model meshes.
+    // Steiner points on polygons that are not flat count against the same bound.
+    fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/prism_n40_d1e-8_s1.poly"),
+        dir.path().join("p.poly"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS5", "p.poly"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("need more than 5 Steiner points (the -S limit)"),
+        "{stderr}"
+    );
+    assert_eq!(listing(dir.path()), ["p.poly", "s.off"]);
+    // With room for them, the same models mesh.
+    Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS100", "p.poly"])
+        .assert()
+        .success();
     Command::cargo_bin("tetcdt")
         .unwrap()
         .current_dir(dir.path())

@@ -184,8 +184,14 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
                 if debug() {
                     eprintln!("restart {}", stats.restarts);
                 }
+                if facet_points.len() + more.len() > opts.max_steiner {
+                    return Err(MeshError::Failed(format!(
+                        "polygons that are not flat need more than {} Steiner points (the -S limit)",
+                        opts.max_steiner
+                    ))
+                    .into());
+                }
                 if stats.restarts > MAX_RESTARTS
-                    || facet_points.len() + more.len() > opts.max_steiner
                     || facet_points.len() + more.len() > max_facet_points(plc)
                 {
                     return Err(MeshError::Failed(format!(
