@@ -36,6 +36,11 @@ impl Contact {
 
 /// The sign of `orient3d` as -1, 0 or 1.
 fn o3(a: &Point, b: &Point, c: &Point, d: &Point) -> i8 {
+    // Four points in one axis-parallel plane (common in CAD models) are coplanar: a
+    // shortcut past the exact stages, which an exactly zero determinant always reaches.
+    if (0..3).any(|k| a[k] == b[k] && a[k] == c[k] && a[k] == d[k]) {
+        return 0;
+    }
     sign(orient3d(a, b, c, d))
 }
 
@@ -231,13 +236,6 @@ pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Opti
             if sb * sc > 0 {
                 return None;
             }
-            let (se, sf) = (
-                o3(&t[0], &t[1], &t[2], &u[1]),
-                o3(&t[0], &t[1], &t[2], &u[2]),
-            );
-            if se * sf > 0 {
-                return None;
-            }
             if sb == 0 && sc == 0 {
                 // Coplanar: the same tests in 2D, without more exact 3D predicates.
                 let ax = axes_of(&t[0], &t[1], &t[2])?;
@@ -246,6 +244,13 @@ pub fn contact(ti: [u32; 3], t: [Point; 3], ui: [u32; 3], u: [Point; 3]) -> Opti
                     || (1..3).any(|k| in_angle(&v, &t[k], &u[1], &u[2], ax))
                     || (1..3).any(|k| in_angle(&v, &u[k], &t[1], &t[2], ax));
                 return meet.then_some(Contact::Overlap);
+            }
+            let (se, sf) = (
+                o3(&t[0], &t[1], &t[2], &u[1]),
+                o3(&t[0], &t[1], &t[2], &u[2]),
+            );
+            if se * sf > 0 {
+                return None;
             }
             seg_tri(&t[1], &t[2], &u)
                 || seg_tri(&u[1], &u[2], &t)
