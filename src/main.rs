@@ -175,6 +175,12 @@ fn parse_args(args: &[OsString]) -> Result<Option<(Options, PathBuf)>, Failure> 
     opts.output = cli.output;
     opts.check = cli.check;
     opts.stats_json = cli.stats_json;
+    if opts.detect_intersections && (opts.check || opts.stats_json.is_some()) {
+        return Err(Failure::new(
+            EXIT_USAGE,
+            anyhow!("-d only detects intersecting facets and makes no mesh: --check and --stats-json do not apply"),
+        ));
+    }
     Ok(Some((opts, cli.file)))
 }
 

@@ -354,6 +354,12 @@ fn steiner_bound_exits_1_with_the_reason() {
 #[test]
 fn usage_and_io_errors() {
     refused("crossing_facets.poly", &["-pq"], 2, &["-q (quality"]);
+    refused(
+        "crossing_facets.poly",
+        &["-d", "--check"],
+        2,
+        &["-d only detects", "--check"],
+    );
     let dir = tempfile::tempdir().unwrap();
     let out = Command::cargo_bin("tetcdt")
         .unwrap()
