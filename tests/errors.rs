@@ -149,6 +149,45 @@ fn collinear_polygon_exits_3_with_coordinates() {
 }
 
 #[test]
+fn polygon_far_from_flat_exits_3() {
+    refused(
+        "twisted_facet.poly",
+        &["-pQ"],
+        3,
+        &[
+            "twisted_facet.poly: facet 2 (line 14), polygon 1 is not flat",
+            "vertex 5 (0, 0, 1) is 1.179e-1 off the polygon's plane",
+            "(at most 1% is accepted)",
+        ],
+    );
+}
+
+/// Found by `tests/fuzz.rs`: a corner of `fig4_split.poly` moved 30 units away twists
+/// three quadrilaterals, which made cavity insertion fail with an internal error.
+#[test]
+fn fuzz_regression_twisted_quads_are_refused() {
+    let text =
+        fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/fig4_split.poly"))
+            .unwrap();
+    assert!(text.contains("\n5 1 -1 -1e-05\n"));
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(
+        dir.path().join("m.poly"),
+        text.replace("\n5 1 -1 -1e-05\n", "\n5 1 -31 -1e-05\n"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQ", "m.poly"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("is not flat"), "{stderr}");
+}
+
+#[test]
 fn duplicate_facet_exits_3() {
     refused(
         "duplicate_facet.poly",

@@ -294,7 +294,65 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
             }
         }
     }
+    // Polygons far from flat: the mesher handles polygons whose vertices are slightly off
+    // a plane (rounded coordinates), not twisted ones.
+    for (fi, f) in plc.facets.iter().enumerate() {
+        for (pi, poly) in f.polygons.iter().enumerate() {
+            let ring = clean_ring(poly, &rep);
+            if let Some((v, dev, size)) = unflat(&plc.points, &ring) {
+                return Err(invalid(
+                    plc,
+                    format!(
+                        "{}, polygon {} is not flat: vertex {} is {dev:.3e} off the polygon's \
+                         plane, {:.2}% of its size {size:.3e} (at most {}% is accepted)",
+                        facet_name(plc, fi),
+                        pi + 1,
+                        point_name(plc, v),
+                        100.0 * dev / size,
+                        100.0 * MAX_UNFLATNESS
+                    ),
+                ));
+            }
+        }
+    }
     Ok(rep)
+}
+
+/// The largest distance of a polygon's vertices from its plane, relative to its size,
+/// that is accepted.
+pub const MAX_UNFLATNESS: f64 = 0.01;
+
+/// For a ring farther from flat than [`MAX_UNFLATNESS`]: its farthest vertex, that
+/// vertex's distance from the plane (Newell normal through the centroid) and the ring's
+/// size (bounding-box diagonal).
+fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
+    if ring.len() < 4 {
+        return None;
+    }
+    let n = crate::constrained::prepare::newell_normal(points, ring);
+    let len = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(len > 0.0) {
+        return None;
+    }
+    let n = n.map(|x| x / len);
+    let m = ring.len() as f64;
+    let c: [f64; 3] =
+        std::array::from_fn(|k| ring.iter().map(|&v| points[v as usize][k]).sum::<f64>() / m);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let mut far = (ring[0], 0.0f64);
+    for &v in ring {
+        let p = points[v as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+        let d = (0..3).map(|k| (p[k] - c[k]) * n[k]).sum::<f64>().abs();
+        if d > far.1 {
+            far = (v, d);
+        }
+    }
+    let size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    (far.1 > MAX_UNFLATNESS * size).then_some((far.0, far.1, size))
 }
 
 /// Duplicate polygons: the same set of (representative) vertices.
