@@ -331,7 +331,7 @@ fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
     }
     let n = crate::constrained::prepare::newell_normal(points, ring);
     let len = n.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if !(len > 0.0) {
+    if len == 0.0 || !len.is_finite() {
         return None;
     }
     let n = n.map(|x| x / len);
