@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod options;
 pub mod output;
 pub mod plc;
+pub mod precheck;
 pub mod progress;
 
 pub use error::{Error, InputError, MeshError};

@@ -37,6 +37,8 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
   -Q     Quiet: no terminal output except errors
   -V     Verbose: print statistics (-VV for more)
+  -d     Only detect intersecting facets: list them, write their triangles to .face
+         (with the points in .node); nothing is written when there are none
 Other TetGen switches (-q, -a, -r, -Y, -T, -o2, -G, -K, ...) are recognised and refused.
 
 Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
@@ -176,6 +178,12 @@ fn parse_args(args: &[OsString]) -> Result<Option<cli::Invocation>, Failure> {
     opts.output = cli.output;
     opts.check = cli.check;
     opts.stats_json = cli.stats_json;
+    if opts.detect_intersections && (opts.check || opts.stats_json.is_some()) {
+        return Err(Failure::new(
+            EXIT_USAGE,
+            anyhow!("-d only detects intersecting facets and makes no mesh: --check and --stats-json do not apply"),
+        ));
+    }
     Ok(Some(cli::Invocation {
         opts,
         files: cli.files,

@@ -63,6 +63,8 @@ pub struct Options {
     pub keep_hull: bool,
     /// `-A`: give each tet its region attribute; needs `-p`.
     pub region_attributes: bool,
+    /// `-d`: only detect intersecting facets, report them and write their triangles.
+    pub detect_intersections: bool,
     /// `-S`: the most Steiner points to add (`-S` alone or `-S0` means no limit).
     pub max_steiner: Option<usize>,
     /// `-k`: also write the mesh as a legacy VTK `.vtk` file.
@@ -182,7 +184,6 @@ const REFUSED: &[(char, Arg, &str)] = &[
     ('m', Arg::None, "mesh sizing function"),
     ('T', Arg::Numbers, "coplanarity tolerance"),
     ('R', Arg::Numbers, "mesh coarsening"),
-    ('d', Arg::None, "detection of self-intersections"),
     ('D', Arg::Numbers, "conforming Delaunay refinement"),
     (
         'L',
@@ -326,6 +327,10 @@ impl Options {
                 'c' => {
                     self.keep_hull = true;
                     seen.keep_hull = true;
+                    true
+                }
+                'd' => {
+                    self.detect_intersections = true;
                     true
                 }
                 'A' => {
@@ -599,6 +604,13 @@ mod tests {
             ),
             (&["O0Q"], Options { quiet: true, ..d() }),
             (
+                &["-d"],
+                Options {
+                    detect_intersections: true,
+                    ..d()
+                },
+            ),
+            (
                 &["-fenzIQV"],
                 Options {
                     all_faces: true,
@@ -650,7 +662,7 @@ mod tests {
             (&["-A"], &["-A (region attributes) needs -p"]),
             (&["-c"], &["-c (convex hull retention) needs -p"]),
             (&["-M"], &["-M (no merging of coplanar facets) needs -p"]),
-            (&["-d"], &["-d (detection"]),
+            (&["-d5"], &["-d does not take the argument \"5\""]),
             (&["-T1e-8"], &["-T1e-8 (coplanarity"]),
             (&["-S1y"], &["unknown switch -y"]),
             (&["-R"], &["-R (mesh coarsening"]),

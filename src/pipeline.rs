@@ -11,10 +11,28 @@ use crate::Meshed;
 use std::time::Instant;
 
 /// Runs the pipeline on `plc` as `opts` asks, telling `progress` when each stage begins.
+/// A model without volume (all points coplanar) is an invalid input, named by its file.
 pub fn run(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
-    if opts.plc {
-        return run_plc(plc, opts, progress);
-    }
+    let r = if opts.plc {
+        run_plc(plc, opts, progress)
+    } else {
+        run_points(plc, opts, progress)
+    };
+    r.map_err(|e| match e {
+        Error::Mesh(MeshError::Degenerate(msg)) if !plc.source.as_os_str().is_empty() => {
+            crate::error::InputError::Invalid {
+                file: plc.source.clone(),
+                msg,
+            }
+            .into()
+        }
+        e => e,
+    })
+}
+
+/// The Delaunay tetrahedralization of a point set.
+fn run_points(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
+    crate::precheck::check_coordinates(plc)?;
     progress(Stage::Delaunay);
     let start = Instant::now();
     let mut stats = Stats {
@@ -76,12 +94,16 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             .max_steiner
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
     };
+    let mut warnings = crate::precheck::check(plc)?;
+    let precheck_secs = start.elapsed().as_secs_f64();
     let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress)?;
+    warnings.extend(done.warnings);
     let ps = done.stats;
     let stats = Stats {
         input_points: plc.points.len(),
         output_tets: ps.output_tets,
         delaunay_secs: ps.delaunay_secs,
+        precheck_secs,
         total_secs: start.elapsed().as_secs_f64(),
         plc: Some(ps),
         ..Default::default()
@@ -89,6 +111,6 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
     Ok(Meshed {
         mesh: done.mesh,
         stats,
-        warnings: done.warnings,
+        warnings,
     })
 }

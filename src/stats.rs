@@ -15,6 +15,8 @@ pub struct Stats {
     pub sort_secs: f64,
     /// Seconds spent building the Delaunay tetrahedralization (including sorting).
     pub delaunay_secs: f64,
+    /// Seconds of the checks before meshing (`-p`: the intersection test above all).
+    pub precheck_secs: f64,
     /// Seconds of the whole meshing call.
     pub total_secs: f64,
     /// The figures of PLC meshing (`-p`), the rows of the paper's Table 1.

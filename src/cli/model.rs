@@ -138,6 +138,15 @@ pub fn run_model(
     say!(say, "Opening {}.", file.display());
     let plc = tetcdt::io::read_plc(file).map_err(tetcdt::Error::from)?;
 
+    if opts.detect_intersections {
+        wopts.comment = Some(comment);
+        detect_only(&plc, &prefix, &wopts, say)?;
+        return Ok(Done {
+            points: 0,
+            stats: Stats::default(),
+        });
+    }
+
     if opts.plc {
         say!(say, "Constrained Delaunay tetrahedralization...");
     } else {
@@ -210,6 +219,27 @@ pub fn run_model(
     })
 }
 
+/// `-d`: report the intersecting facets and write their triangles; no meshing.
+fn detect_only(
+    plc: &tetcdt::Plc,
+    prefix: &Path,
+    wopts: &WriteOptions,
+    say: &Say<'_>,
+) -> Result<(), Failure> {
+    say!(say, "Detecting self-intersecting facets...");
+    let found = tetcdt::precheck::detect::detect(plc).map_err(tetcdt::Error::from)?;
+    for w in &found.warnings {
+        say.warn(w);
+    }
+    for line in found.report(plc) {
+        say!(say, "{line}");
+    }
+    tetcdt::precheck::detect::write(plc, &found, prefix, wopts, &mut |p: &Path| {
+        say!(say, "Writing {}.", p.display());
+    })?;
+    Ok(())
+}
+
 /// The `-V` statistics (with `-p`, the rows of the paper's Table 1).
 fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed) {
     let s = &meshed.stats;
@@ -224,6 +254,7 @@ fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed) {
     say!(say, "  Convex hull faces: {}", s.hull_faces);
     say!(say, "");
     say!(say, "  Sorting seconds: {}", s.sort_secs);
+    say!(say, "  Check seconds: {}", s.precheck_secs);
     say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
     say!(say, "  Meshing seconds: {}", s.total_secs);
     let rows = s.table1_rows();

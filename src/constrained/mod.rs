@@ -133,10 +133,9 @@ pub fn mesh_plc_with_progress(
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
     let mut prep = prepare(plc, opts.merge)?;
-    if !opts.keep_hull {
-        if let Some(rim) = enclosure::open_boundary(plc, &prep) {
-            return Err(MeshError::InvalidPlc(open_surface_message(plc, &rim)).into());
-        }
+    // The message lists the boundary edges in the input's own terms.
+    if !opts.keep_hull && enclosure::open_boundary(plc, &prep).is_some() {
+        return Err(MeshError::InvalidPlc(crate::precheck::empty_domain_message(plc)).into());
     }
     // Input facets kept out of merging because their merged group could not be
     // triangulated in one plane.
@@ -144,9 +143,12 @@ pub fn mesh_plc_with_progress(
     let mut warnings = Vec::new();
     for &(dup, kept) in &prep.duplicates {
         warnings.push(format!(
-            "point {} coincides with point {} and is merged with it",
+            "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
             dup as usize + plc.first_index,
-            kept as usize + plc.first_index
+            kept as usize + plc.first_index,
+            plc.points[kept as usize][0],
+            plc.points[kept as usize][1],
+            plc.points[kept as usize][2]
         ));
     }
     let mut stats = PlcStats {
@@ -207,8 +209,14 @@ pub fn mesh_plc_with_progress(
                 if debug() {
                     eprintln!("restart {}", stats.restarts);
                 }
+                if facet_points.len() + more.len() > opts.max_steiner {
+                    return Err(MeshError::Failed(format!(
+                        "polygons that are not flat need more than {} Steiner points (the -S limit)",
+                        opts.max_steiner
+                    ))
+                    .into());
+                }
                 if stats.restarts > MAX_RESTARTS
-                    || facet_points.len() + more.len() > opts.max_steiner
                     || facet_points.len() + more.len() > max_facet_points(plc)
                 {
                     return Err(MeshError::Failed(format!(
@@ -733,32 +741,6 @@ fn regions_of(
     out
 }
 
-/// The refusal of a surface that encloses nothing, naming its first boundary edges.
-fn open_surface_message(plc: &Plc, rim: &[[u32; 2]]) -> String {
-    let shown: Vec<String> = rim
-        .iter()
-        .take(5)
-        .map(|&[a, b]| {
-            let p = |v: u32| plc.points[v as usize];
-            format!(
-                "{}-{} ({:?} to {:?})",
-                a as usize + plc.first_index,
-                b as usize + plc.first_index,
-                p(a),
-                p(b)
-            )
-        })
-        .collect();
-    format!(
-        "the surface is open and encloses no volume, so the meshed domain would be empty \
-         (-c keeps the convex hull instead): {} boundary edge(s) lie on only one facet, \
-         first: {}{}",
-        rim.len(),
-        shown.join(", "),
-        if rim.len() > shown.len() { ", ..." } else { "" }
-    )
-}
-
 /// Carves the mesh and puts it in output form.
 fn finish(
     plc: &Plc,
@@ -774,11 +756,10 @@ fn finish(
     let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
     stats.carve_secs = t.elapsed().as_secs_f64();
     if carved.tets.is_empty() {
-        return Err(MeshError::InvalidPlc(
-            "no tetrahedra remain after removing the exterior: the surface does not enclose a volume \
-             (is it closed?)"
-                .into(),
-        )
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::empty_domain_message(plc),
+        }
         .into());
     }
     let n_out = cdt

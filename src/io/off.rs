@@ -6,7 +6,9 @@
 //! starting directly with the counts is accepted too), then one vertex per line (`x y z`,
 //! further columns such as normals, colors or texture coordinates are ignored), then one
 //! face per line `<n> <v0> ... <v(n-1)> [color...]` with any `n >= 1` (1: an isolated
-//! vertex, 2: a segment). `#` starts a comment. The edge section is ignored.
+//! vertex, 2: a segment); a face whose line ends before its corners goes on over the next
+//! lines, since Geomview reads OFF token by token. `#` starts a comment. The edge section
+//! is ignored.
 //!
 //! Vertices are numbered from 0 (`first_index = 0`); each face becomes one facet with one
 //! polygon and marker 0. (TetGen 1.5, given an `.off` file with `-p`, writes boundary
@@ -103,8 +105,15 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
         if n == 0 {
             return Err(line.error(format!("face {f} has no corners")));
         }
+        let first_line = line.number();
         let mut polygon = Vec::with_capacity(n.min(line.remaining_len() / 2 + 1));
         for c in 0..n {
+            if line.at_end() {
+                // Geomview reads OFF token by token: a face may go on over several lines.
+                line = lines.expect_line(|| {
+                    format!("corner {c} of face {f} (line {first_line} announces {n})")
+                })?;
+            }
             let v = line.int(|| format!("corner {c} of face {f}"))?;
             let index = corner_index(v, 0, nv, "vertex", "vertices")
                 .map_err(|msg| line.error(format!("face {f} {msg}")))?;
@@ -114,7 +123,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
             polygons: vec![polygon],
             holes: Vec::new(),
             marker: 0,
-            line: line.number(),
+            line: first_line,
         });
     }
     Ok(plc)
@@ -237,7 +246,11 @@ mod tests {
         );
         assert_eq!(
             parse_err(&format!("OFF\n5 1 0\n{BODY}4 0 1 2\n")),
-            "t.off:8: expected corner 3 of face 0, but the line ends"
+            "t.off:8: unexpected end of file: expected corner 3 of face 0 (line 8 announces 4)"
+        );
+        assert_eq!(
+            parse_err(&format!("OFF\n5 1 0\n{BODY}4 0 1 2\nx\n")),
+            "t.off:9: expected corner 3 of face 0 (an integer), found `x`"
         );
         assert_eq!(
             parse_err(&format!("OFF\n5 1 0\n{BODY}0\n")),

@@ -1,0 +1,472 @@
+//! One test per kind of error: the exit code, and the message naming the file, the
+//! elements (numbered as in the file) and, where it helps, coordinates. The broken
+//! models are hand-made, in `data/broken/`. Every failed run must leave no output.
+//!
+//! Exit codes: 0 success, 1 meshing failed, 2 usage error, 3 invalid input, 4 I/O error.
+
+use assert_cmd::Command;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+fn broken(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join("broken")
+        .join(name)
+}
+
+/// The files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Copies `data/broken/<name>` into a fresh directory and runs `tetcdt <args> <name>`
+/// there. Returns (exit code, stdout, stderr, directory listing after the run).
+fn run(name: &str, args: &[&str]) -> (i32, String, String, Vec<String>) {
+    let dir = tempfile::tempdir().unwrap();
+    fs::copy(broken(name), dir.path().join(name)).unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(args)
+        .arg(name)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        listing(dir.path()),
+    )
+}
+
+/// A run that must fail with `code`, print every one of `wants`, and write nothing.
+fn refused(name: &str, args: &[&str], code: i32, wants: &[&str]) {
+    let (got, _, stderr, files) = run(name, args);
+    assert_eq!(got, code, "{name}: {stderr}");
+    assert!(stderr.starts_with("tetcdt: "), "{name}: {stderr}");
+    for w in wants {
+        assert!(stderr.contains(w), "{name}: {stderr:?} lacks {w:?}");
+    }
+    assert!(!stderr.contains("panicked") && !stderr.contains("internal error"));
+    assert_eq!(files, [name], "{name}: a failed run must write nothing");
+}
+
+#[test]
+fn malformed_files_exit_3_naming_file_and_line() {
+    refused(
+        "nan_coordinate.node",
+        &["-Q"],
+        3,
+        &["nan_coordinate.node:5:", "point 3", "not a finite number"],
+    );
+    refused(
+        "missing_points.smesh",
+        &["-pQ"],
+        3,
+        &[
+            "missing_points.smesh:5:",
+            "unexpected end of file",
+            "8 announced",
+        ],
+    );
+    refused(
+        "short_polygon.off",
+        &["-pQ"],
+        3,
+        &["short_polygon.off:11:", "corner 3 of face 3"],
+    );
+    // A header count is never trusted for allocation: 4 billion vertices announced.
+    refused(
+        "huge_count.off",
+        &["-pQ"],
+        3,
+        &["huge_count.off:5:", "4000000000 announced"],
+    );
+}
+
+#[test]
+fn out_of_range_index_exits_3() {
+    refused(
+        "index_out_of_range.poly",
+        &["-pQ"],
+        3,
+        &[
+            "index_out_of_range.poly:",
+            "facet 3",
+            "corner 9",
+            "only 8 points",
+        ],
+    );
+}
+
+#[test]
+fn coordinates_beyond_the_predicates_range_exit_3() {
+    for args in [&["-pQ"][..], &["-Q"][..]] {
+        refused(
+            "huge_coordinate.off",
+            args,
+            3,
+            &[
+                "huge_coordinate.off: point 1 ",
+                "out of the supported range",
+                "1e300",
+            ],
+        );
+    }
+}
+
+#[test]
+fn repeated_vertex_exits_3() {
+    refused(
+        "repeated_vertex.poly",
+        &["-pQ"],
+        3,
+        &[
+            "repeated_vertex.poly: facet 4 (line 18), polygon 1",
+            "vertex 3 is repeated (positions 2 and 4 of 5)",
+        ],
+    );
+}
+
+#[test]
+fn collinear_polygon_exits_3_with_coordinates() {
+    refused(
+        "collinear_polygon.poly",
+        &["-pQ"],
+        3,
+        &[
+            "collinear_polygon.poly: facet 7 (line 25), polygon 1",
+            "collinear",
+            "9 (0.5, 0.5, 0.5)",
+        ],
+    );
+}
+
+#[test]
+fn polygon_far_from_flat_exits_3() {
+    refused(
+        "twisted_facet.poly",
+        &["-pQ"],
+        3,
+        &[
+            "twisted_facet.poly: facet 2 (line 14), polygon 1 is not flat",
+            "vertex 5 (0, 0, 1) is 1.179e-1 off the polygon's plane",
+            "(at most 1% is accepted)",
+        ],
+    );
+}
+
+/// Found by `tests/fuzz.rs`: a corner of `fig4_split.poly` moved 30 units away twists
+/// three quadrilaterals, which made cavity insertion fail with an internal error.
+#[test]
+fn fuzz_regression_twisted_quads_are_refused() {
+    let text =
+        fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/fig4_split.poly"))
+            .unwrap();
+    assert!(text.contains("\n5 1 -1 -1e-05\n"));
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(
+        dir.path().join("m.poly"),
+        text.replace("\n5 1 -1 -1e-05\n", "\n5 1 -31 -1e-05\n"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQ", "m.poly"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("is not flat"), "{stderr}");
+}
+
+#[test]
+fn duplicate_facet_exits_3() {
+    refused(
+        "duplicate_facet.poly",
+        &["-pQ"],
+        3,
+        &[
+            "1 duplicate polygon(s)",
+            "facet 2 (line 14), polygon 1 and facet 7 (line 24), polygon 1",
+        ],
+    );
+}
+
+#[test]
+fn coincident_points_are_merged_with_a_warning() {
+    let (code, _, stderr, files) = run("coincident_points.poly", &["-p", "--check"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("Warning: point 9 coincides with point 5 at (0, 0, 1)"),
+        "{stderr}"
+    );
+    assert!(files.contains(&"coincident_points.1.ele".to_string()));
+}
+
+#[test]
+fn open_surface_exits_3_listing_boundary_edges() {
+    refused(
+        "open_box.poly",
+        &["-pQ"],
+        3,
+        &[
+            "open_box.poly: the meshed domain would be empty",
+            "not closed: 4 boundary edge(s)",
+            "5 (0, 0, 1) – 6 (1, 0, 1)",
+        ],
+    );
+    // With -c the hull is kept, and the open box is a valid PLC.
+    let (code, _, stderr, _) = run("open_box.poly", &["-pcQ", "--check"]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
+fn open_facet_inside_a_closed_one_is_fine() {
+    let (code, _, stderr, _) = run("dangling_facet_inside.poly", &["-pQ", "--check"]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
+fn intersecting_facets_exit_3_naming_the_pairs() {
+    refused(
+        "crossing_facets.poly",
+        &["-pQ"],
+        3,
+        &[
+            "1 pair(s) of facets intersect",
+            "facet 2 (line 17) and facet 7 (line 27) (crossing)",
+            "(9, 10, 11)",
+        ],
+    );
+    refused(
+        "touching_facets.poly",
+        &["-pQ"],
+        3,
+        &["facet 2 (line 18) and facet 7 (line 28) (touching)"],
+    );
+    refused(
+        "overlapping_facets.off",
+        &["-pQ"],
+        3,
+        &[
+            "2 pair(s) of facets intersect",
+            "facet 0 (line 11) and facet 4 (line 15) (coplanar overlap)",
+        ],
+    );
+}
+
+#[test]
+fn segment_through_a_facet_exits_3() {
+    refused(
+        "crossing_segment.poly",
+        &["-pQ"],
+        3,
+        &[
+            "1 segment(s) meet a facet other than at a shared vertex",
+            "segment (9, 10) of facet 7 (line 26) and facet 2 (line 16) (crossing)",
+        ],
+    );
+}
+
+#[test]
+fn point_on_a_facet_that_does_not_list_it_exits_3() {
+    refused(
+        "stray_point.poly",
+        &["-pQ"],
+        3,
+        &[
+            "stray_point.poly: 1 point(s) lie on a facet without being among its vertices",
+            "point 12 (0.5, 0.5, 1) lies on facet 2 (line 18)",
+        ],
+    );
+}
+
+#[test]
+fn detect_switch_reports_and_writes_the_triangles() {
+    let (code, stdout, stderr, files) = run("crossing_facets.poly", &["-d"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("facet 2 (line 17) and facet 7 (line 27) (crossing)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("Found 1 pair(s) of intersecting facets."),
+        "{stdout}"
+    );
+    assert_eq!(
+        files,
+        [
+            "crossing_facets.1.face",
+            "crossing_facets.1.node",
+            "crossing_facets.poly"
+        ]
+    );
+    // The .face file: the two triangles, numbered like the input (from 1), with markers.
+    let dir = tempfile::tempdir().unwrap();
+    fs::copy(broken("crossing_facets.poly"), dir.path().join("m.poly")).unwrap();
+    Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-dQ", "m.poly"])
+        .assert()
+        .success();
+    let face = fs::read_to_string(dir.path().join("m.1.face")).unwrap();
+    let rows: Vec<Vec<&str>> = face
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    assert_eq!(rows[0], ["2", "1"]);
+    assert_eq!(rows[1][..4], ["1", "5", "6", "7"]);
+    assert_eq!(rows[2][..4], ["2", "9", "10", "11"]);
+    let node = fs::read_to_string(dir.path().join("m.1.node")).unwrap();
+    assert!(node.starts_with("11  3  0  0"), "{node}");
+
+    // No intersections: said so, nothing written, exit 0 (as TetGen does).
+    let (code, stdout, stderr, files) = run("dangling_facet_inside.poly", &["-d"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("No faces are intersecting."), "{stdout}");
+    assert_eq!(files, ["dangling_facet_inside.poly"]);
+}
+
+#[test]
+fn steiner_bound_exits_1_with_the_reason() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join("plc")
+        .join("schonhardt.off");
+    let dir = tempfile::tempdir().unwrap();
+    fs::copy(&model, dir.path().join("s.off")).unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS1", "s.off"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("more than 1 Steiner points"), "{stderr}");
+    assert!(stderr.contains("-S"), "{stderr}");
+    assert_eq!(listing(dir.path()), ["s.off"]);
+    // Steiner points on polygons that are not flat count against the same bound.
+    fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/prism_n40_d1e-8_s1.poly"),
+        dir.path().join("p.poly"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS5", "p.poly"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("need more than 5 Steiner points (the -S limit)"),
+        "{stderr}"
+    );
+    assert_eq!(listing(dir.path()), ["p.poly", "s.off"]);
+    // With room for them, the same models mesh.
+    Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS100", "p.poly"])
+        .assert()
+        .success();
+    Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS100", "s.off"])
+        .assert()
+        .success();
+}
+
+#[test]
+fn usage_and_io_errors() {
+    refused("crossing_facets.poly", &["-pq"], 2, &["-q (quality"]);
+    refused(
+        "crossing_facets.poly",
+        &["-d", "--check"],
+        2,
+        &["-d only detects", "--check"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQ", "nothing.poly"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(4));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nothing.poly"));
+}
+
+/// A failed run keeps the outputs of an earlier successful one intact and leaves no
+/// temporary files: outputs are written under temporary names and renamed at the end,
+/// and the input is checked before anything is written.
+#[test]
+fn failed_run_keeps_earlier_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::copy(broken("dangling_facet_inside.poly"), d.join("m.poly")).unwrap();
+    let ok = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(d)
+        .args(["-pQ", "m.poly"])
+        .output()
+        .unwrap();
+    assert_eq!(ok.status.code(), Some(0));
+    let before: Vec<(String, Vec<u8>)> = listing(d)
+        .into_iter()
+        .map(|f| (f.clone(), fs::read(d.join(&f)).unwrap()))
+        .collect();
+    assert_eq!(before.len(), 5, "{:?}", listing(d));
+    for (bad, code) in [
+        ("crossing_facets.poly", 3),
+        ("open_box.poly", 3),
+        ("repeated_vertex.poly", 3),
+    ] {
+        fs::copy(broken(bad), d.join("m.poly")).unwrap();
+        let out = Command::cargo_bin("tetcdt")
+            .unwrap()
+            .current_dir(d)
+            .args(["-pQ", "m.poly"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(code), "{bad}");
+        for (f, bytes) in &before {
+            if f != "m.poly" {
+                assert_eq!(&fs::read(d.join(f)).unwrap(), bytes, "{bad} changed {f}");
+            }
+        }
+        assert_eq!(listing(d).len(), 5, "{bad}: {:?}", listing(d));
+    }
+    // The Steiner bound is hit after meshing started: still nothing is touched.
+    fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/schonhardt.off"),
+        d.join("m.off"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(d)
+        .args(["-pQS1", "-o", "m.1", "m.off"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    for (f, bytes) in &before {
+        if f != "m.poly" {
+            assert_eq!(&fs::read(d.join(f)).unwrap(), bytes, "-S1 changed {f}");
+        }
+    }
+    assert_eq!(listing(d).len(), 6, "{:?}", listing(d));
+}
