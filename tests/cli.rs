@@ -773,12 +773,9 @@ fn an_open_surface_is_refused_before_meshing_naming_its_rim() {
     fs::write(dir.path().join("open.off"), off).unwrap();
     let (code, _, err) = run_in(dir.path(), &["-pQ", "open.off"]);
     assert_eq!(code, 3, "{err}");
-    assert!(err.contains("open and encloses no volume"), "{err}");
+    assert!(err.contains("the meshed domain would be empty"), "{err}");
     assert!(err.contains("4 boundary edge(s)"), "{err}");
-    assert!(
-        err.contains("4-5 ([0.0, 0.0, 1.0] to [1.0, 0.0, 1.0])"),
-        "{err}"
-    );
+    assert!(err.contains("4 (0, 0, 1) – 5 (1, 0, 1)"), "{err}");
     assert_eq!(listing(dir.path()), vec!["open.off"]);
     // With -c the convex hull is meshed instead.
     let (code, _, err) = run_in(dir.path(), &["-pcQ", "open.off"]);
