@@ -1,7 +1,7 @@
 //! The meshing pipeline: read model → Delaunay → (segments → facets → carve) → output.
 
 use crate::delaunay::Delaunay;
-use crate::error::{Error, MeshError};
+use crate::error::Error;
 use crate::options::Options;
 use crate::output::MeshOut;
 use crate::plc::Plc;
@@ -58,12 +58,6 @@ pub fn run(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
 
 /// The `-p` pipeline: the constrained Delaunay tetrahedralization of the PLC, carved.
 fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
-    if opts.facet_algo == crate::options::FacetAlgo::Flip {
-        return Err(MeshError::Unsupported(
-            "facet insertion by flips (-F) is not implemented yet".into(),
-        )
-        .into());
-    }
     let start = Instant::now();
     let popts = crate::constrained::PlcOptions {
         merge: !opts.no_merge,
@@ -73,6 +67,10 @@ fn run_plc(plc: &Plc, opts: &Options) -> Result<Meshed, Error> {
         max_steiner: opts
             .max_steiner
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
+        inserter: match opts.facet_algo {
+            crate::options::FacetAlgo::Cavity => crate::constrained::FacetInserter::Cavity,
+            crate::options::FacetAlgo::Flip => crate::constrained::FacetInserter::Flip,
+        },
     };
     let done = crate::constrained::mesh_plc(plc, &popts)?;
     let ps = done.stats;

@@ -9,6 +9,7 @@
 pub mod cavity;
 pub mod cdt;
 pub mod facet2d;
+pub mod flip;
 pub mod prepare;
 pub mod segments;
 
@@ -36,6 +37,35 @@ pub struct PlcOptions {
     pub region_attributes: bool,
     /// The most Steiner points to add (`-S`).
     pub max_steiner: usize,
+    /// How missing regions are inserted (`-C` / `-F`).
+    pub inserter: FacetInserter,
+}
+
+/// The facet insertion algorithm: both insert one missing region at a time, with the
+/// same contract (see [`cavity::insert_region`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FacetInserter {
+    /// Cavity retriangulation (paper §3.1, `-C`).
+    #[default]
+    Cavity,
+    /// Bistellar flips with exact flip-time ordering (paper §3.2, `-F`).
+    Flip,
+}
+
+impl FacetInserter {
+    /// Inserts the region `tris` of facet `facet`.
+    pub fn insert(
+        self,
+        cdt: &mut Cdt,
+        tris: &[[VertexId; 3]],
+        facet: u32,
+        normal: [f64; 3],
+    ) -> Result<Outcome, MeshError> {
+        match self {
+            FacetInserter::Cavity => insert_region(cdt, tris, facet, normal),
+            FacetInserter::Flip => flip::insert_region(cdt, tris, facet, normal),
+        }
+    }
 }
 
 impl Default for PlcOptions {
@@ -45,6 +75,7 @@ impl Default for PlcOptions {
             keep_hull: false,
             region_attributes: false,
             max_steiner: 10_000_000,
+            inserter: FacetInserter::Cavity,
         }
     }
 }
@@ -86,6 +117,12 @@ pub struct PlcStats {
     pub facet_secs: f64,
     /// Seconds for carving.
     pub carve_secs: f64,
+    /// The facet insertion algorithm used.
+    pub inserter: FacetInserter,
+    /// Flip insertion's figures (`-F`).
+    pub flips: flip::FlipCounts,
+    /// Facets whose regions fell back from flips to cavity retriangulation.
+    pub flip_fallback_facets: Vec<u32>,
 }
 
 /// The finished PLC mesh, its figures, and warnings for the user.
@@ -134,6 +171,7 @@ pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
         ));
     }
     let mut stats = PlcStats {
+        inserter: opts.inserter,
         input_points: plc.points.len(),
         input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
         ..Default::default()
@@ -373,8 +411,15 @@ fn attempt(
             }
         }
         for region in regions_of(&missing, &seg_markers) {
-            match insert_region(&mut cdt, &region, fi as u32, f.normal)? {
+            match opts
+                .inserter
+                .insert(&mut cdt, &region, fi as u32, f.normal)?
+            {
                 Outcome::Inserted(rs) => {
+                    stats.flips.add(&rs.flips);
+                    if rs.flips.fallbacks > 0 {
+                        stats.flip_fallback_facets.push(fi as u32);
+                    }
                     stats.regions += 1;
                     stats.recovered_subfaces += rs.subfaces;
                     stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);

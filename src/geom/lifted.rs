@@ -321,8 +321,7 @@ impl FlipTime {
 /// `J_a > 0` it is positive iff `b`'s face is not locally regular at `a`'s flip time.
 pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut CompareCounts) -> i32 {
     if a.sorted_ids == b.sorted_ids
-        && a
-            .sorted_ids
+        && a.sorted_ids
             .iter()
             .all(|&id| left_of(a, id) == left_of(b, id))
     {
@@ -503,9 +502,8 @@ mod tests {
         let mut certs: Vec<(FlipTime, i128, i128)> = Vec::new();
         let mut next_id = 0u32;
         while certs.len() < 300 {
-            let mut p: [Point; 5] = std::array::from_fn(|_| {
-                std::array::from_fn(|_| (lcg(&mut s) * 9.0).floor() - 4.0)
-            });
+            let mut p: [Point; 5] =
+                std::array::from_fn(|_| std::array::from_fn(|_| (lcg(&mut s) * 9.0).floor() - 4.0));
             let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
             if o == 0.0 {
                 continue;
@@ -538,7 +536,10 @@ mod tests {
                 }
             }
         }
-        assert!(ties > 0 && counts.exact > 0 && counts.perturbed > 0, "{counts:?}");
+        assert!(
+            ties > 0 && counts.exact > 0 && counts.perturbed > 0,
+            "{counts:?}"
+        );
         // Nearby integer configurations (one coordinate moved by one), ordered exactly.
         let mut s = 5u64;
         for _ in 0..20000 {
@@ -558,7 +559,10 @@ mod tests {
                 continue;
             }
             let want = (ib * ja - ia * jb).signum() as i32;
-            let (a, b) = (cert(&lift, p, [0, 1, 2, 3, 4]), cert(&lift, q, [0, 1, 2, 3, 5]));
+            let (a, b) = (
+                cert(&lift, p, [0, 1, 2, 3, 4]),
+                cert(&lift, q, [0, 1, 2, 3, 5]),
+            );
             let got = cross_sign(&a, &b, &lift, &mut counts);
             if want != 0 {
                 assert_eq!(got, want);

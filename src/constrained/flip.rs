@@ -1,0 +1,764 @@
+//! Facet insertion by bistellar flips (Shewchuk's flip algorithm; the paper's §3.2).
+//!
+//! The tets crossing a missing region R are flipped until no crossing triangle is left.
+//! Left vertices (one side of the polygon's plane) are lifted at a rate proportional to
+//! their height `Orient3D(a, b, c, v)`, so the tets in R stay a weighted CDT as time τ
+//! grows; each crossing triangle is certified with the time at which its two tets become
+//! cohyperplanar (Equation 1), and the earliest flip is done first. Flip times are
+//! compared exactly, ties broken by TetGen's symbolic perturbation (`geom::lifted`), so
+//! flips come off the queue in the right order.
+//!
+//! The paper's three safeguards are kept (and counted): a flip that would remove a tet
+//! outside R is refused; non-crossing faces next to new non-crossing tets are checked for
+//! local regularity and flipped if needed; a flip that cannot be done yet waits in a list
+//! L and is retried after every flip. If the region is still missing when the queue runs
+//! dry, the region falls back to cavity retriangulation, which is counted and reported.
+//!
+//! After the region is in, the weights are restored: faces in R that are not locally
+//! Delaunay (polygons that are not exactly flat) are repaired by flips where possible,
+//! and otherwise the region asks for a Steiner point on the polygon, like the cavity
+//! algorithm does.
+
+use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
+use super::cdt::{edge_key, face_key, Cdt};
+use crate::error::MeshError;
+use crate::geom::lifted::{cross_sign, CompareCounts, FlipTime, Lifting};
+use crate::geom::{insphere_sos, orient3d, Point, Sign};
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// Figures of flip insertion, summed over regions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FlipCounts {
+    /// 2-3 flips.
+    pub flips23: usize,
+    /// 3-2 flips.
+    pub flips32: usize,
+    /// 4-4 flips.
+    pub flips44: usize,
+    /// Flips that restored local Delaunayhood after the weights were restored.
+    pub repair_flips: usize,
+    /// Safeguard 1: flips refused because they would remove a tet outside R.
+    pub outside_r: usize,
+    /// Safeguard 2: non-crossing faces found not locally regular, and flipped.
+    pub not_regular: usize,
+    /// Safeguard 3: flips that could not be done when dequeued and went to list L.
+    pub deferred: usize,
+    /// Flips refused because they would remove a subsegment or a triangle of the region.
+    pub constrained: usize,
+    /// Regions that fell back to cavity retriangulation.
+    pub fallbacks: usize,
+    /// Flip-time comparisons that needed exact arithmetic.
+    pub exact_compares: usize,
+    /// Of those, exact ties broken by the symbolic perturbation.
+    pub perturbed_compares: usize,
+}
+
+impl FlipCounts {
+    /// Adds `o` to these counts.
+    pub fn add(&mut self, o: &FlipCounts) {
+        self.flips23 += o.flips23;
+        self.flips32 += o.flips32;
+        self.flips44 += o.flips44;
+        self.repair_flips += o.repair_flips;
+        self.outside_r += o.outside_r;
+        self.not_regular += o.not_regular;
+        self.deferred += o.deferred;
+        self.constrained += o.constrained;
+        self.fallbacks += o.fallbacks;
+        self.exact_compares += o.exact_compares;
+        self.perturbed_compares += o.perturbed_compares;
+    }
+
+    /// All flips done.
+    pub fn total(&self) -> usize {
+        self.flips23 + self.flips32 + self.flips44
+    }
+}
+
+/// Why a flip was not done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Refusal {
+    /// It would remove a tet outside R (safeguard 1).
+    OutsideR,
+    /// It would remove a subsegment or a triangle of the region.
+    Constrained,
+    /// The tets around the face do not allow a 2-3, 3-2 or 4-4 flip now.
+    NotFlippable,
+}
+
+/// A certified face: its flip time and the two tets it was certified for.
+struct Event {
+    time: FlipTime,
+    face: FaceRef,
+    t1: [VertexId; 4],
+    t2: [VertexId; 4],
+    /// A face found not locally regular now (safeguard 2): flipped before anything else.
+    forced: bool,
+}
+
+/// Inserts the region `tris` of facet `facet` by flips; same contract as
+/// [`cavity::insert_region`].
+pub fn insert_region(
+    cdt: &mut Cdt,
+    tris: &[[VertexId; 3]],
+    facet: u32,
+    normal: [f64; 3],
+) -> Result<Outcome, MeshError> {
+    let region = Region::new(cdt, tris);
+    let crossing = crossing_tets(cdt, &region);
+    if crossing.is_empty() {
+        // Nothing to flip: the cavity code adopts the mesh's own faces or asks for a point.
+        return cavity::insert_region(cdt, tris, facet, normal);
+    }
+    let lift = Lifting {
+        abc: largest_triangle(cdt, &region),
+    };
+    let mut fl = Flipper::new(cdt, &region, lift, &crossing);
+    let done = fl.run()?;
+    let mut counts = fl.counts;
+    counts.exact_compares = fl.cmp.exact;
+    counts.perturbed_compares = fl.cmp.perturbed;
+    let mut at_risk = std::mem::take(&mut fl.at_risk);
+    let problem = if done {
+        fl.repair()?
+    } else {
+        Some(Problem::Stuck)
+    };
+    drop(fl);
+    let flat = region
+        .verts
+        .iter()
+        .all(|&v| lift.side(&cdt.dt.points[v as usize]) == 0);
+    match problem {
+        None => {}
+        Some(Problem::Shim(f)) | Some(Problem::NotDelaunay(f)) if !flat => {
+            return Ok(Outcome::NeedsSteiner(steiner_point(cdt, tris, f, normal)));
+        }
+        Some(p) => {
+            if debug() {
+                eprintln!("facet {facet}: flip insertion falls back to cavity ({p:?})");
+            }
+            counts.fallbacks += 1;
+            let mut lost = lost_subfaces(cdt, &mut at_risk);
+            return Ok(match cavity::insert_region(cdt, tris, facet, normal)? {
+                Outcome::Inserted(mut rs) => {
+                    rs.lost.append(&mut lost);
+                    rs.lost.sort_unstable();
+                    rs.lost.dedup();
+                    rs.flips = counts;
+                    Outcome::Inserted(rs)
+                }
+                other => other,
+            });
+        }
+    }
+    let lost = lost_subfaces(cdt, &mut at_risk);
+    for t in tris {
+        cdt.subfaces.insert(face_key(*t), facet);
+    }
+    Ok(Outcome::Inserted(RegionStats {
+        lost,
+        crossing_tets: crossing.len(),
+        enlarged_tets: 0,
+        subfaces: tris.len(),
+        flips: counts,
+    }))
+}
+
+/// Whether to trace fallbacks on stderr (`TETCDT_DEBUG=1`).
+fn debug() -> bool {
+    std::env::var_os("TETCDT_DEBUG").is_some()
+}
+
+/// Removes the subfaces among `at_risk` that are no longer mesh faces; their facets.
+fn lost_subfaces(cdt: &mut Cdt, at_risk: &mut Vec<[VertexId; 3]>) -> Vec<u32> {
+    at_risk.sort_unstable();
+    at_risk.dedup();
+    let mut lost = Vec::new();
+    for key in at_risk.drain(..) {
+        if cdt.find_face(key[0], key[1], key[2]).is_none() {
+            if let Some(f) = cdt.subfaces.remove(&key) {
+                lost.push(f);
+            }
+        }
+    }
+    lost.sort_unstable();
+    lost.dedup();
+    lost
+}
+
+/// Three region vertices spanning approximately the largest triangle: the farthest
+/// vertex from the first, then the vertex farthest from their line.
+fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
+    verts.sort_unstable();
+    let a = p(verts[0]);
+    let d2 = |x: Point, y: Point| (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>();
+    let b = verts
+        .iter()
+        .map(|&v| p(v))
+        .max_by(|x, y| d2(*x, a).total_cmp(&d2(*y, a)))
+        .unwrap_or(a);
+    let area = |c: Point| {
+        let u: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
+        let w: [f64; 3] = std::array::from_fn(|k| c[k] - a[k]);
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+    };
+    let c = verts
+        .iter()
+        .map(|&v| p(v))
+        .max_by(|x, y| area(*x).total_cmp(&area(*y)))
+        .unwrap_or(a);
+    [a, b, c]
+}
+
+/// What keeps a finished region from being a CDT.
+#[derive(Clone, Copy, Debug)]
+enum Problem {
+    /// The queue ran dry (or the flip budget ran out) with the region still missing.
+    Stuck,
+    /// A tet with four vertices on the polygon; one of its faces.
+    Shim([VertexId; 3]),
+    /// A face that is not locally Delaunay and no flip repairs.
+    NotDelaunay([VertexId; 3]),
+}
+
+/// The state of one region's flip insertion.
+struct Flipper<'a> {
+    cdt: &'a mut Cdt,
+    region: &'a Region,
+    lift: Lifting,
+    /// Side of each vertex of R: 1 left (weighted), -1 right, 0 on the polygon.
+    side: FxHashMap<VertexId, i8>,
+    /// The tets of R (they change as flips replace them).
+    in_r: FxHashSet<TetId>,
+    region_faces: FxHashSet<[VertexId; 3]>,
+    events: Vec<Event>,
+    heap: Vec<u32>,
+    /// List L: dequeued flips that could not be done yet.
+    deferred: Vec<u32>,
+    /// The event being processed: the current time.
+    current: Option<u32>,
+    counts: FlipCounts,
+    cmp: CompareCounts,
+    /// Subfaces among the faces of deleted tets.
+    at_risk: Vec<[VertexId; 3]>,
+}
+
+impl<'a> Flipper<'a> {
+    fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
+        let mut side = FxHashMap::default();
+        for &t in crossing {
+            for v in cdt.dt.mesh.verts(t) {
+                side.entry(v).or_insert_with(|| {
+                    if region.verts.contains(&v) {
+                        0
+                    } else {
+                        lift.side(&cdt.dt.points[v as usize]) as i8
+                    }
+                });
+            }
+        }
+        Flipper {
+            cdt,
+            region,
+            lift,
+            side,
+            in_r: crossing.iter().copied().collect(),
+            region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
+            events: Vec::new(),
+            heap: Vec::new(),
+            deferred: Vec::new(),
+            current: None,
+            counts: FlipCounts::default(),
+            cmp: CompareCounts::default(),
+            at_risk: Vec::new(),
+        }
+    }
+
+    /// Flips until no crossing triangle is left; true if the region's triangles are then
+    /// all mesh faces.
+    fn run(&mut self) -> Result<bool, MeshError> {
+        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        r.sort_unstable();
+        for &t in &r {
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                let n = self.cdt.dt.mesh.adj(f).tet();
+                if t < n && self.in_r.contains(&n) {
+                    self.certify(f);
+                }
+            }
+        }
+        let budget = 50 * r.len() + 1000;
+        let mut flips = 0;
+        while let Some(e) = self.pop() {
+            if !self.valid(e) {
+                continue;
+            }
+            flips += 1;
+            if flips > budget {
+                return Ok(false);
+            }
+            match self.try_flip(self.events[e as usize].face, false)? {
+                Ok(new) => {
+                    self.current = Some(e);
+                    self.after_flip(&new);
+                    self.retry_deferred()?;
+                }
+                Err(why) => {
+                    self.count_refusal(why);
+                    self.deferred.push(e);
+                    self.counts.deferred += 1;
+                }
+            }
+        }
+        let tris = self.region.tris.clone();
+        Ok(tris
+            .iter()
+            .all(|t| self.cdt.find_face(t[0], t[1], t[2]).is_some()))
+    }
+
+    fn count_refusal(&mut self, why: Refusal) {
+        match why {
+            Refusal::OutsideR => self.counts.outside_r += 1,
+            Refusal::Constrained => self.counts.constrained += 1,
+            Refusal::NotFlippable => {}
+        }
+    }
+
+    /// Retries the flips in list L until none succeeds; drops the stale ones.
+    fn retry_deferred(&mut self) -> Result<(), MeshError> {
+        loop {
+            let mut progress = false;
+            let list = std::mem::take(&mut self.deferred);
+            let mut keep = Vec::new();
+            for e in list {
+                if !self.valid(e) {
+                    continue;
+                }
+                match self.try_flip(self.events[e as usize].face, false)? {
+                    Ok(new) => {
+                        self.after_flip(&new);
+                        progress = true;
+                    }
+                    Err(_) => keep.push(e),
+                }
+            }
+            self.deferred.extend(keep);
+            if !progress || self.deferred.is_empty() {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Certifies the crossing faces of the new tets, and checks the non-crossing faces
+    /// between non-crossing tets for local regularity now (safeguard 2).
+    fn after_flip(&mut self, new: &[TetId]) {
+        for &t in new {
+            let crossing_tet = self.is_crossing(&self.cdt.dt.mesh.verts(t));
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                let g = self.cdt.dt.mesh.adj(f);
+                if !self.in_r.contains(&g.tet()) {
+                    continue;
+                }
+                let fv = self.cdt.dt.mesh.face_verts(t, i);
+                if self.is_crossing(&fv) {
+                    self.certify(f);
+                    continue;
+                }
+                if crossing_tet || self.is_crossing(&self.cdt.dt.mesh.verts(g.tet())) {
+                    continue;
+                }
+                if self.region_faces.contains(&face_key(fv)) || self.cdt.is_subface(t, i) {
+                    continue;
+                }
+                let Some(cur) = self.current else { continue };
+                let time = self.flip_time(f);
+                let now = &self.events[cur as usize].time;
+                if cross_sign(now, &time, &self.lift, &mut self.cmp) > 0 {
+                    self.counts.not_regular += 1;
+                    self.push_event(f, time, true);
+                }
+            }
+        }
+    }
+
+    fn is_crossing(&self, verts: &[VertexId]) -> bool {
+        let mut l = false;
+        let mut r = false;
+        for v in verts {
+            match self.side.get(v) {
+                Some(1) => l = true,
+                Some(-1) => r = true,
+                _ => {}
+            }
+        }
+        l && r
+    }
+
+    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last).
+    fn flip_time(&self, f: FaceRef) -> FlipTime {
+        let mesh = &self.cdt.dt.mesh;
+        let g = mesh.adj(f);
+        let s = mesh.face_verts(f.tet(), f.face());
+        let v = mesh.verts(f.tet())[f.face()];
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [s[0], s[1], s[2], v, w];
+        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        let left = ids.map(|x| self.side.get(&x) == Some(&1));
+        FlipTime::new(&self.lift, pts, orig, left)
+    }
+
+    /// Queues the flip of crossing face `f` if it ever happens.
+    fn certify(&mut self, f: FaceRef) {
+        let time = self.flip_time(f);
+        if time.flips(&self.lift) {
+            self.push_event(f, time, false);
+        }
+    }
+
+    fn push_event(&mut self, f: FaceRef, time: FlipTime, forced: bool) {
+        let mesh = &self.cdt.dt.mesh;
+        let e = Event {
+            time,
+            face: f,
+            t1: mesh.verts(f.tet()),
+            t2: mesh.verts(mesh.adj(f).tet()),
+            forced,
+        };
+        self.events.push(e);
+        let idx = (self.events.len() - 1) as u32;
+        self.heap.push(idx);
+        let mut k = self.heap.len() - 1;
+        while k > 0 {
+            let parent = (k - 1) / 2;
+            if self.earlier(self.heap[k], self.heap[parent]) {
+                self.heap.swap(k, parent);
+                k = parent;
+            } else {
+                break;
+            }
+        }
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        if self.heap.is_empty() {
+            return None;
+        }
+        let top = self.heap.swap_remove(0);
+        let n = self.heap.len();
+        let mut k = 0;
+        loop {
+            let (l, r) = (2 * k + 1, 2 * k + 2);
+            let mut m = k;
+            if l < n && self.earlier(self.heap[l], self.heap[m]) {
+                m = l;
+            }
+            if r < n && self.earlier(self.heap[r], self.heap[m]) {
+                m = r;
+            }
+            if m == k {
+                break;
+            }
+            self.heap.swap(k, m);
+            k = m;
+        }
+        Some(top)
+    }
+
+    /// Does event `a` come strictly before event `b`?
+    fn earlier(&mut self, a: u32, b: u32) -> bool {
+        let (ea, eb) = (&self.events[a as usize], &self.events[b as usize]);
+        if ea.forced != eb.forced {
+            return ea.forced;
+        }
+        if ea.forced {
+            return a < b;
+        }
+        match cross_sign(&ea.time, &eb.time, &self.lift, &mut self.cmp) {
+            0 => a < b,
+            s => s < 0,
+        }
+    }
+
+    /// Are the event's two tets still there, glued at its face?
+    fn valid(&self, e: u32) -> bool {
+        let ev = &self.events[e as usize];
+        let mesh = &self.cdt.dt.mesh;
+        let (t1, t2) = (ev.face.tet(), mesh.adj(ev.face).tet());
+        mesh.is_alive(t1)
+            && mesh.verts(t1) == ev.t1
+            && mesh.is_alive(t2)
+            && mesh.verts(t2) == ev.t2
+            && self.in_r.contains(&t1)
+            && self.in_r.contains(&t2)
+    }
+
+    /// Removes face `f` by a 2-3, 3-2 or 4-4 flip, if the tets around it allow one and
+    /// it keeps the constraints; returns the new tets. `repair` allows flips outside the
+    /// crossing set's logic (the weights are restored) but still only inside R.
+    fn try_flip(
+        &mut self,
+        f: FaceRef,
+        repair: bool,
+    ) -> Result<Result<Vec<TetId>, Refusal>, MeshError> {
+        let mesh = &self.cdt.dt.mesh;
+        let (t1, i) = (f.tet(), f.face());
+        let g = mesh.adj(f);
+        let t2 = g.tet();
+        let v = mesh.verts(t1)[i];
+        let w = mesh.verts(t2)[g.face()];
+        let s = mesh.face_verts(t1, i);
+        let base = [s[0], s[1], s[2], v];
+        let rep = |k: usize| {
+            let mut b = base;
+            b[k] = w;
+            b
+        };
+        let pts = &self.cdt.dt.points;
+        let orient = |t: &[VertexId; 4]| {
+            let p = t.map(|x| &pts[x as usize]);
+            orient3d(p[0], p[1], p[2], p[3])
+        };
+        let o: [f64; 3] = std::array::from_fn(|k| orient(&rep(k)));
+        let neg: Vec<usize> = (0..3).filter(|&k| o[k] < 0.0).collect();
+        let zero: Vec<usize> = (0..3).filter(|&k| o[k] == 0.0).collect();
+        // The face of t1 opposite s[k] (it holds the edge of s without s[k], and v).
+        let opposite = |t: TetId, x: VertexId| {
+            let tv = mesh.verts(t);
+            (0..4).find(|&j| tv[j] == x)
+        };
+        let (old, new, kind): (Vec<TetId>, Vec<[VertexId; 4]>, usize) =
+            if neg.is_empty() && zero.is_empty() {
+                if self.region_faces.contains(&face_key(s)) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                (vec![t1, t2], vec![rep(0), rep(1), rep(2)], 23)
+            } else if neg.len() == 1 && zero.is_empty() {
+                let k = neg[0];
+                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+                let Some(j) = opposite(t1, s[k]) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                let t3 = mesh.adj(FaceRef::new(t1, j)).tet();
+                if !mesh.verts(t3).contains(&w) {
+                    return Ok(Err(Refusal::NotFlippable));
+                }
+                if self.edge_is_constrained(e0, e1, &[s[k], v, w]) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                (
+                    vec![t1, t2, t3],
+                    vec![rep((k + 1) % 3), rep((k + 2) % 3)],
+                    32,
+                )
+            } else if zero.len() == 1 && neg.is_empty() {
+                let k = zero[0];
+                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+                let (Some(j1), Some(j2)) = (opposite(t1, s[k]), opposite(t2, s[k])) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                let t3 = mesh.adj(FaceRef::new(t1, j1)).tet();
+                let t4 = mesh.adj(FaceRef::new(t2, j2)).tet();
+                let t3v = mesh.verts(t3);
+                let t4v = mesh.verts(t4);
+                let Some(&u) = t3v.iter().find(|&&x| x != e0 && x != e1 && x != v) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                if u == w || !t4v.contains(&u) || !t4v.contains(&w) {
+                    return Ok(Err(Refusal::NotFlippable));
+                }
+                if self.edge_is_constrained(e0, e1, &[s[k], v, w, u]) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                // On u's side: t3 with e0 (then e1) replaced by w.
+                let mut extra = Vec::new();
+                for e in [e0, e1] {
+                    let mut t = t3v;
+                    if let Some(p) = t.iter().position(|&x| x == e) {
+                        t[p] = w;
+                    }
+                    if orient(&t) <= 0.0 {
+                        return Ok(Err(Refusal::NotFlippable));
+                    }
+                    extra.push(t);
+                }
+                let mut new = vec![rep((k + 1) % 3), rep((k + 2) % 3)];
+                new.extend(extra);
+                (vec![t1, t2, t3, t4], new, 44)
+            } else {
+                return Ok(Err(Refusal::NotFlippable));
+            };
+        if old.iter().any(|t| !self.in_r.contains(t)) {
+            return Ok(Err(Refusal::OutsideR));
+        }
+        let made = self.replace(&old, &new)?;
+        if repair {
+            self.counts.repair_flips += 1;
+        } else {
+            match kind {
+                23 => self.counts.flips23 += 1,
+                32 => self.counts.flips32 += 1,
+                _ => self.counts.flips44 += 1,
+            }
+        }
+        Ok(Ok(made))
+    }
+
+    /// Would removing edge `e0e1` (with the faces it spans with `apices`) lose a
+    /// subsegment or a triangle of the region?
+    fn edge_is_constrained(&self, e0: VertexId, e1: VertexId, apices: &[VertexId]) -> bool {
+        self.cdt.subsegs.contains_key(&edge_key(e0, e1))
+            || apices
+                .iter()
+                .any(|&x| self.region_faces.contains(&face_key([e0, e1, x])))
+    }
+
+    /// Replaces tets `old` by the positively oriented tets `new` (which fill the same
+    /// volume), gluing them to each other and to the outside.
+    fn replace(&mut self, old: &[TetId], new: &[[VertexId; 4]]) -> Result<Vec<TetId>, MeshError> {
+        let mesh = &mut self.cdt.dt.mesh;
+        let mut outer: Vec<([VertexId; 3], FaceRef)> = Vec::with_capacity(8);
+        let check_subfaces = !self.cdt.subfaces.is_empty();
+        for &t in old {
+            for j in 0..4 {
+                let key = face_key(mesh.face_verts(t, j));
+                let n = mesh.adj(FaceRef::new(t, j));
+                if !old.contains(&n.tet()) {
+                    outer.push((key, n));
+                }
+                if check_subfaces && self.cdt.subfaces.contains_key(&key) {
+                    self.at_risk.push(key);
+                }
+            }
+        }
+        for &t in old {
+            mesh.kill_tet(t);
+            self.in_r.remove(&t);
+        }
+        let mut made = Vec::with_capacity(new.len());
+        for &v in new {
+            let t = mesh
+                .add_tet(v)
+                .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
+            made.push(t);
+        }
+        let keys: Vec<[[VertexId; 3]; 4]> = new
+            .iter()
+            .map(|v| std::array::from_fn(|j| face_key(FACE_VERTS[j].map(|x| v[x]))))
+            .collect();
+        for a in 0..made.len() {
+            'faces: for j in 0..4 {
+                for b in 0..made.len() {
+                    if b == a {
+                        continue;
+                    }
+                    if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == keys[a][j]) {
+                        if b > a {
+                            mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
+                        }
+                        continue 'faces;
+                    }
+                }
+                let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == keys[a][j]) else {
+                    return Err(MeshError::Internal(format!(
+                        "a flip left face {:?} without a neighbour",
+                        keys[a][j]
+                    )));
+                };
+                mesh.glue(FaceRef::new(made[a], j), n);
+            }
+        }
+        for &t in &made {
+            for x in mesh.verts(t) {
+                mesh.set_vertex_tet(x, t);
+            }
+            self.in_r.insert(t);
+        }
+        Ok(made)
+    }
+
+    /// With the weights restored: flips the faces in R that are not locally Delaunay
+    /// where a flip keeping the region can, and reports a shim or a face that remains.
+    fn repair(&mut self) -> Result<Option<Problem>, MeshError> {
+        let mut work: Vec<FaceRef> = Vec::new();
+        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        r.sort_unstable();
+        for &t in &r {
+            for i in 0..4 {
+                work.push(FaceRef::new(t, i));
+            }
+        }
+        let mut budget = 20 * r.len() + 100;
+        let mut stuck: Vec<FaceRef> = Vec::new();
+        while let Some(f) = work.pop() {
+            if !self.not_delaunay(f) {
+                continue;
+            }
+            if budget == 0 {
+                stuck.push(f);
+                continue;
+            }
+            budget -= 1;
+            match self.try_flip(f, true)? {
+                Ok(new) => {
+                    for t in new {
+                        for i in 0..4 {
+                            work.push(FaceRef::new(t, i));
+                        }
+                    }
+                }
+                Err(_) => stuck.push(f),
+            }
+        }
+        for f in stuck {
+            if self.not_delaunay(f) {
+                return Ok(Some(Problem::NotDelaunay(
+                    self.cdt.dt.mesh.face_verts(f.tet(), f.face()),
+                )));
+            }
+        }
+        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        r.sort_unstable();
+        for t in r {
+            let v = self.cdt.dt.mesh.verts(t);
+            if v.iter().all(|x| self.region.verts.contains(x)) {
+                return Ok(Some(Problem::Shim([v[0], v[1], v[2]])));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Is face `f` (between two live tets of R, not a constraint) not locally Delaunay?
+    fn not_delaunay(&mut self, f: FaceRef) -> bool {
+        let mesh = &self.cdt.dt.mesh;
+        let t = f.tet();
+        if !mesh.is_alive(t) || !self.in_r.contains(&t) {
+            return false;
+        }
+        let g = mesh.adj(f);
+        if !self.in_r.contains(&g.tet()) {
+            return false;
+        }
+        let s = mesh.face_verts(t, f.face());
+        if self.region_faces.contains(&face_key(s)) || self.cdt.is_subface(t, f.face()) {
+            return false;
+        }
+        let tv = mesh.verts(t);
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [tv[0], tv[1], tv[2], tv[3], w];
+        let p = ids.map(|x| &self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        insphere_sos(p, orig) == Sign::Positive
+    }
+}
