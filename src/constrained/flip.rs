@@ -22,7 +22,7 @@
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
 use super::cdt::{edge_key, face_key, Cdt};
 use crate::error::MeshError;
-use crate::geom::lifted::{cross_sign, CompareCounts, FlipTime, Lifting};
+use crate::geom::lifted::{cross_sign, Approx, CompareCounts, FlipTime, Lifting};
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
 use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -235,8 +235,9 @@ struct Flipper<'a> {
     cdt: &'a mut Cdt,
     region: &'a Region,
     lift: Lifting,
-    /// Side of each vertex of R: 1 left (weighted), -1 right, 0 on the polygon.
-    side: FxHashMap<VertexId, i8>,
+    /// Side of each vertex of R (1 left, weighted; -1 right; 0 on the polygon), and
+    /// its height.
+    side: FxHashMap<VertexId, (i8, Approx)>,
     /// The tets of R (they change as flips replace them).
     in_r: FxHashSet<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
@@ -258,11 +259,13 @@ impl<'a> Flipper<'a> {
         for &t in crossing {
             for v in cdt.dt.mesh.verts(t) {
                 side.entry(v).or_insert_with(|| {
-                    if region.verts.contains(&v) {
+                    let p = &cdt.dt.points[v as usize];
+                    let s = if region.verts.contains(&v) {
                         0
                     } else {
-                        lift.side(&cdt.dt.points[v as usize]) as i8
-                    }
+                        lift.side(p) as i8
+                    };
+                    (s, lift.height_approx(p, s == 1))
                 });
             }
         }
@@ -382,6 +385,12 @@ impl<'a> Flipper<'a> {
                     continue;
                 }
                 let Some(cur) = self.current else { continue };
+                // On one closed side the lift is affine: regularity cannot change.
+                let apex = self.cdt.dt.mesh.verts(g.tet())[g.face()];
+                let tv = self.cdt.dt.mesh.verts(t);
+                if !self.is_crossing(&[tv[0], tv[1], tv[2], tv[3], apex]) {
+                    continue;
+                }
                 let time = self.flip_time(f);
                 let now = &self.events[cur as usize].time;
                 if cross_sign(now, &time, &self.lift, &mut self.cmp) > 0 {
@@ -397,8 +406,8 @@ impl<'a> Flipper<'a> {
         let mut r = false;
         for v in verts {
             match self.side.get(v) {
-                Some(1) => l = true,
-                Some(-1) => r = true,
+                Some((1, _)) => l = true,
+                Some((-1, _)) => r = true,
                 _ => {}
             }
         }
@@ -415,8 +424,9 @@ impl<'a> Flipper<'a> {
         let ids = [s[0], s[1], s[2], v, w];
         let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
-        let left = ids.map(|x| self.side.get(&x) == Some(&1));
-        FlipTime::new(&self.lift, pts, orig, left)
+        let zero = Approx { v: 0.0, p: 0.0 };
+        let sh = ids.map(|x| self.side.get(&x).copied().unwrap_or((0, zero)));
+        FlipTime::new(pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
     }
 
     /// Queues the flip of crossing face `f` if it ever happens.

@@ -17,29 +17,38 @@ use super::Point;
 use std::cell::OnceCell;
 use std::cmp::Ordering;
 
-/// A closed interval of reals, rounded outward: a rigorous bound on a computed value.
+/// A floating-point value with its permanent (the same expression evaluated on absolute
+/// values). An expression tree of depth d evaluated from exact inputs is off by at most
+/// γ_d times the permanent; all ours have depth at most 12 ([`ERR`]).
 #[derive(Copy, Clone, Debug, PartialEq)]
-pub struct Interval {
-    /// Lower bound.
-    pub lo: f64,
-    /// Upper bound.
-    pub hi: f64,
+pub struct Approx {
+    /// The value, rounded.
+    pub v: f64,
+    /// The permanent, rounded.
+    pub p: f64,
 }
 
-impl Interval {
-    /// The exact double `x`.
-    pub fn point(x: f64) -> Self {
-        Interval { lo: x, hi: x }
+/// Bound on the relative (to the permanent) error of every evaluation here: γ_12 is
+/// about 1.34e-15; the margin also covers the rounding of the permanent itself.
+const ERR: f64 = 3.0e-15;
+/// Outside this range of permanents, underflow or overflow could break the bounds.
+const RANGE: (f64, f64) = (1e-120, 1e120);
+
+impl Approx {
+    /// The error bound, or `None` when the value is outside the range of the analysis.
+    #[inline]
+    fn err(&self) -> Option<f64> {
+        (self.p == 0.0 || (self.p > RANGE.0 && self.p < RANGE.1)).then_some(ERR * self.p)
     }
 
-    /// The sign if the interval settles it (`None` when it contains zero and more, or is
-    /// not a number).
+    /// The sign if the error bound settles it.
     pub fn sign(&self) -> Option<i32> {
-        if self.lo > 0.0 {
+        let e = self.err()?;
+        if self.v > e {
             Some(1)
-        } else if self.hi < 0.0 {
+        } else if -self.v > e {
             Some(-1)
-        } else if self.lo == 0.0 && self.hi == 0.0 {
+        } else if self.p == 0.0 {
             Some(0)
         } else {
             None
@@ -61,56 +70,35 @@ pub trait Arith: Clone {
     fn times(&self, o: &Self) -> Self;
 }
 
-impl Arith for Interval {
+impl Arith for Approx {
+    #[inline(always)]
     fn diff(a: f64, b: f64) -> Self {
-        let d = a - b;
-        // The rounding error of the difference, exactly (two-sum): often zero.
-        let bv = d - a;
-        let err = (a - (d - bv)) + (-b - bv);
-        if err == 0.0 && d.is_finite() {
-            return Interval::point(d);
-        }
-        Interval {
-            lo: d.next_down(),
-            hi: d.next_up(),
-        }
+        let v = a - b;
+        Approx { v, p: v.abs() }
     }
+    #[inline(always)]
     fn constant(x: f64) -> Self {
-        Interval::point(x)
+        Approx { v: x, p: x.abs() }
     }
+    #[inline(always)]
     fn plus(&self, o: &Self) -> Self {
-        Interval {
-            lo: (self.lo + o.lo).next_down(),
-            hi: (self.hi + o.hi).next_up(),
+        Approx {
+            v: self.v + o.v,
+            p: self.p + o.p,
         }
     }
+    #[inline(always)]
     fn minus(&self, o: &Self) -> Self {
-        Interval {
-            lo: (self.lo - o.hi).next_down(),
-            hi: (self.hi - o.lo).next_up(),
+        Approx {
+            v: self.v - o.v,
+            p: self.p + o.p,
         }
     }
+    #[inline(always)]
     fn times(&self, o: &Self) -> Self {
-        let p = [
-            self.lo * o.lo,
-            self.lo * o.hi,
-            self.hi * o.lo,
-            self.hi * o.hi,
-        ];
-        let mut lo = p[0];
-        let mut hi = p[0];
-        for &x in &p[1..] {
-            // NaN (0 * inf) poisons both bounds, so the sign stays undecided.
-            if x < lo || x.is_nan() {
-                lo = if x.is_nan() { f64::NAN } else { x };
-            }
-            if x > hi || x.is_nan() {
-                hi = if x.is_nan() { f64::NAN } else { x };
-            }
-        }
-        Interval {
-            lo: lo.next_down(),
-            hi: hi.next_up(),
+        Approx {
+            v: self.v * o.v,
+            p: self.p * o.p,
         }
     }
 }
@@ -222,6 +210,11 @@ impl Lifting {
         }
     }
 
+    /// The height of `v` in floating point, with its permanent (zero unless left).
+    pub fn height_approx(&self, v: &Point, left: bool) -> Approx {
+        self.height(v, left)
+    }
+
     fn height<T: Arith>(&self, v: &Point, left: bool) -> T {
         if left {
             let [a, b, c] = &self.abc;
@@ -250,8 +243,8 @@ pub struct FlipTime {
     pub ids: [u32; 5],
     /// Which points are left vertices (weighted).
     pub left: [bool; 5],
-    i: Interval,
-    j: Interval,
+    i: Approx,
+    j: Approx,
     exact: OnceCell<Box<(Expansion, Expansion)>>,
     sorted_ids: [u32; 5],
 }
@@ -268,10 +261,10 @@ pub struct CompareCounts {
 }
 
 impl FlipTime {
-    /// The certificate of the face `pts[0..3]` between apices `pts[3]` and `pts[4]`.
-    pub fn new(lift: &Lifting, pts: [Point; 5], ids: [u32; 5], left: [bool; 5]) -> Self {
-        let d: [[Interval; 3]; 4] = rows(&pts);
-        let h: [Interval; 5] = std::array::from_fn(|k| lift.height(&pts[k], left[k]));
+    /// The certificate of the face `pts[0..3]` between apices `pts[3]` and `pts[4]`,
+    /// given the points' heights ([`Lifting::height_approx`], zero unless left).
+    pub fn new(pts: [Point; 5], ids: [u32; 5], left: [bool; 5], h: [Approx; 5]) -> Self {
+        let d: [[Approx; 3]; 4] = rows(&pts);
         let mut sorted_ids = ids;
         sorted_ids.sort_unstable();
         FlipTime {
@@ -304,7 +297,7 @@ impl FlipTime {
 
     /// The approximate flip time (for reports; the order uses [`compare`]).
     pub fn approx(&self) -> f64 {
-        -(self.i.lo + self.i.hi) / (self.j.lo + self.j.hi)
+        -self.i.v / self.j.v
     }
 
     /// The perturbation coefficient of vertex index `id` (zero if not one of the points).
@@ -328,12 +321,9 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         // The same five lifted points: the same hyperplane, the same event.
         return 0;
     }
-    let s = b.i.times(&a.j).minus(&a.i.times(&b.j));
-    if let Some(s) = s.sign() {
-        if s != 0 {
-            counts.filtered += 1;
-            return s;
-        }
+    if let Some(s) = filtered_cross(a, b) {
+        counts.filtered += 1;
+        return s;
     }
     counts.exact += 1;
     let (ia, ja) = a.exact(lift);
@@ -354,6 +344,33 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         }
     }
     0
+}
+
+/// The sign of `I_b·J_a − I_a·J_b` if the floating-point values and their error bounds
+/// settle it.
+#[inline]
+fn filtered_cross(a: &FlipTime, b: &FlipTime) -> Option<i32> {
+    let (eia, eja, eib, ejb) = (a.i.err()?, a.j.err()?, b.i.err()?, b.j.err()?);
+    let (x, y) = (b.i.v * a.j.v, a.i.v * b.j.v);
+    let s = x - y;
+    // |Îb·Ĵa − Ib·Ja| ≤ eIb·(|Ĵa| + eJa) + |Îb|·eJa, likewise for the other product, plus
+    // the rounding of the two products and the difference.
+    let bound = (eib * (a.j.v.abs() + eja)
+        + b.i.v.abs() * eja
+        + eia * (b.j.v.abs() + ejb)
+        + a.i.v.abs() * ejb
+        + 4.0 * f64::EPSILON * (x.abs() + y.abs()))
+        * (1.0 + 1e-12);
+    if !(bound < f64::MAX) || bound < 1e-290 && s != 0.0 {
+        return None;
+    }
+    if s > bound {
+        Some(1)
+    } else if -s > bound {
+        Some(-1)
+    } else {
+        None
+    }
 }
 
 fn left_of(f: &FlipTime, id: u32) -> bool {
@@ -405,10 +422,10 @@ mod tests {
         let mut s = 3u64;
         for _ in 0..2000 {
             let p: [Point; 5] = std::array::from_fn(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)]);
-            let d: [[Interval; 3]; 4] = rows(&p);
+            let d: [[Approx; 3]; 4] = rows(&p);
             let i = insphere_value(&d);
             let want = insphere(&p[0], &p[1], &p[2], &p[3], &p[4]);
-            assert!(i.lo <= want.max(i.lo) && i.sign().is_none_or(|x| x as f64 * want > 0.0));
+            assert!(i.sign().is_none_or(|x| x as f64 * want > 0.0));
             let de: [[Expansion; 3]; 4] = rows(&p);
             assert_eq!(insphere_value(&de).sign() as f64 * want.signum(), 1.0);
             let o: Expansion = orient(&p[0], &p[1], &p[2], &p[3]);
@@ -461,7 +478,8 @@ mod tests {
 
     fn cert(lift: &Lifting, p: [Point; 5], ids: [u32; 5]) -> FlipTime {
         let left = p.map(|q| lift.side(&q) > 0);
-        FlipTime::new(lift, p, ids, left)
+        let h = std::array::from_fn(|k| lift.height_approx(&p[k], left[k]));
+        FlipTime::new(p, ids, left, h)
     }
 
     /// Integer reference: `I` and `J` exactly in i128 for small integer coordinates.
