@@ -22,7 +22,9 @@
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
 use super::cdt::{edge_key, face_key, Cdt};
 use crate::error::MeshError;
-use crate::geom::lifted::{cross_sign, Approx, CompareCounts, FlipTime, Lifting};
+use crate::geom::lifted::{
+    cross_sign, key_cross, Approx, CompareCounts, FlipTime, Lifting, TimeKey,
+};
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
 use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -242,7 +244,11 @@ struct Flipper<'a> {
     in_r: FxHashSet<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
     events: Vec<Event>,
-    heap: Vec<u32>,
+    /// Event slots free for reuse.
+    free_events: Vec<u32>,
+    /// The priority queue: events with their flip times' floating-point keys (most
+    /// comparisons are settled by the keys alone, without touching the events).
+    heap: Vec<(TimeKey, u32)>,
     /// List L: dequeued flips that could not be done yet.
     deferred: Vec<u32>,
     /// The event being processed: the current time.
@@ -277,6 +283,7 @@ impl<'a> Flipper<'a> {
             in_r: crossing.iter().copied().collect(),
             region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
             events: Vec::new(),
+            free_events: Vec::new(),
             heap: Vec::new(),
             deferred: Vec::new(),
             current: None,
@@ -304,6 +311,7 @@ impl<'a> Flipper<'a> {
         let mut flips = 0;
         while let Some(e) = self.pop() {
             if !self.valid(e) {
+                self.free_events.push(e);
                 continue;
             }
             flips += 1;
@@ -312,7 +320,9 @@ impl<'a> Flipper<'a> {
             }
             match self.try_flip(self.events[e as usize].face, false)? {
                 Ok(new) => {
-                    self.current = Some(e);
+                    if let Some(old) = self.current.replace(e) {
+                        self.free_events.push(old);
+                    }
                     self.after_flip(&new);
                     self.retry_deferred()?;
                 }
@@ -345,11 +355,13 @@ impl<'a> Flipper<'a> {
             let mut keep = Vec::new();
             for e in list {
                 if !self.valid(e) {
+                    self.free_events.push(e);
                     continue;
                 }
                 match self.try_flip(self.events[e as usize].face, false)? {
                     Ok(new) => {
                         self.after_flip(&new);
+                        self.free_events.push(e);
                         progress = true;
                     }
                     Err(_) => keep.push(e),
@@ -446,9 +458,18 @@ impl<'a> Flipper<'a> {
             t2: mesh.verts(mesh.adj(f).tet()),
             forced,
         };
-        self.events.push(e);
-        let idx = (self.events.len() - 1) as u32;
-        self.heap.push(idx);
+        let key = e.time.key();
+        let idx = match self.free_events.pop() {
+            Some(i) => {
+                self.events[i as usize] = e;
+                i
+            }
+            None => {
+                self.events.push(e);
+                (self.events.len() - 1) as u32
+            }
+        };
+        self.heap.push((key, idx));
         let mut k = self.heap.len() - 1;
         while k > 0 {
             let parent = (k - 1) / 2;
@@ -465,7 +486,7 @@ impl<'a> Flipper<'a> {
         if self.heap.is_empty() {
             return None;
         }
-        let top = self.heap.swap_remove(0);
+        let (_, top) = self.heap.swap_remove(0);
         let n = self.heap.len();
         let mut k = 0;
         loop {
@@ -486,9 +507,15 @@ impl<'a> Flipper<'a> {
         Some(top)
     }
 
-    /// Does event `a` come strictly before event `b`?
-    fn earlier(&mut self, a: u32, b: u32) -> bool {
+    /// Does heap entry `a` come strictly before heap entry `b`?
+    fn earlier(&mut self, (ka, a): (TimeKey, u32), (kb, b): (TimeKey, u32)) -> bool {
         let (ea, eb) = (&self.events[a as usize], &self.events[b as usize]);
+        if !ea.forced && !eb.forced {
+            if let Some(s) = key_cross(&ka, &kb) {
+                self.cmp.filtered += 1;
+                return s < 0;
+            }
+        }
         if ea.forced != eb.forced {
             return ea.forced;
         }

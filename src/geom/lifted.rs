@@ -246,7 +246,6 @@ pub struct FlipTime {
     i: Approx,
     j: Approx,
     exact: OnceCell<Box<(Expansion, Expansion)>>,
-    sorted_ids: [u32; 5],
 }
 
 /// Counts of how the comparisons were decided (for tuning and tests).
@@ -265,8 +264,6 @@ impl FlipTime {
     /// given the points' heights ([`Lifting::height_approx`], zero unless left).
     pub fn new(pts: [Point; 5], ids: [u32; 5], left: [bool; 5], h: [Approx; 5]) -> Self {
         let d: [[Approx; 3]; 4] = rows(&pts);
-        let mut sorted_ids = ids;
-        sorted_ids.sort_unstable();
         FlipTime {
             pts,
             ids,
@@ -274,7 +271,6 @@ impl FlipTime {
             i: insphere_value(&d),
             j: height_value(&d, &h),
             exact: OnceCell::new(),
-            sorted_ids,
         }
     }
 
@@ -313,17 +309,17 @@ impl FlipTime {
 /// terms. With `J_a > 0` and `J_b > 0` it is negative iff `a` flips before `b`; with
 /// `J_a > 0` it is positive iff `b`'s face is not locally regular at `a`'s flip time.
 pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut CompareCounts) -> i32 {
-    if a.sorted_ids == b.sorted_ids
-        && a.sorted_ids
-            .iter()
-            .all(|&id| left_of(a, id) == left_of(b, id))
-    {
-        // The same five lifted points: the same hyperplane, the same event.
-        return 0;
-    }
     if let Some(s) = filtered_cross(a, b) {
         counts.filtered += 1;
         return s;
+    }
+    if a
+        .ids
+        .iter()
+        .all(|&id| b.ids.contains(&id) && left_of(a, id) == left_of(b, id))
+    {
+        // The same five lifted points: the same hyperplane, the same event.
+        return 0;
     }
     counts.exact += 1;
     let (ia, ja) = a.exact(lift);
@@ -344,6 +340,53 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         }
     }
     0
+}
+
+/// The floating-point part of a flip time, compact enough to keep in a heap entry:
+/// `I` and `J` with their error bounds (NaN bounds when outside the analysed range).
+#[derive(Copy, Clone, Debug)]
+pub struct TimeKey {
+    i: f64,
+    j: f64,
+    ei: f64,
+    ej: f64,
+}
+
+impl FlipTime {
+    /// The compact key of this flip time.
+    pub fn key(&self) -> TimeKey {
+        TimeKey {
+            i: self.i.v,
+            j: self.j.v,
+            ei: self.i.err().unwrap_or(f64::NAN),
+            ej: self.j.err().unwrap_or(f64::NAN),
+        }
+    }
+}
+
+/// The sign of `I_b·J_a − I_a·J_b` from two keys, if the error bounds settle it.
+#[inline]
+pub fn key_cross(a: &TimeKey, b: &TimeKey) -> Option<i32> {
+    let (eia, eja, eib, ejb) = (a.ei, a.ej, b.ei, b.ej);
+    let (x, y) = (b.i * a.j, a.i * b.j);
+    let s = x - y;
+    let bound = (eib * (a.j.abs() + eja)
+        + b.i.abs() * eja
+        + eia * (b.j.abs() + ejb)
+        + a.i.abs() * ejb
+        + 4.0 * f64::EPSILON * (x.abs() + y.abs()))
+        * (1.0 + 1e-12);
+    // NaN bounds (out of range) fail both tests below.
+    if !(bound < f64::MAX) || (bound < 1e-290 && s != 0.0) {
+        return None;
+    }
+    if s > bound {
+        Some(1)
+    } else if -s > bound {
+        Some(-1)
+    } else {
+        None
+    }
 }
 
 /// The sign of `I_b·J_a − I_a·J_b` if the floating-point values and their error bounds
