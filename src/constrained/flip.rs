@@ -95,8 +95,6 @@ struct Event {
     face: FaceRef,
     t1: [VertexId; 4],
     t2: [VertexId; 4],
-    /// A face found not locally regular now (safeguard 2): flipped before anything else.
-    forced: bool,
 }
 
 /// Inserts the region `tris` of facet `facet` by flips; same contract as
@@ -247,8 +245,9 @@ struct Flipper<'a> {
     /// Event slots free for reuse.
     free_events: Vec<u32>,
     /// The priority queue: events with their flip times' floating-point keys (most
-    /// comparisons are settled by the keys alone, without touching the events).
-    heap: Vec<(TimeKey, u32)>,
+    /// comparisons are settled by the keys alone, without touching the events), and
+    /// whether the face was found not locally regular now (safeguard 2: flipped first).
+    heap: Vec<(TimeKey, u32, bool)>,
     /// List L: dequeued flips that could not be done yet.
     deferred: Vec<u32>,
     /// The event being processed: the current time.
@@ -456,7 +455,6 @@ impl<'a> Flipper<'a> {
             face: f,
             t1: mesh.verts(f.tet()),
             t2: mesh.verts(mesh.adj(f).tet()),
-            forced,
         };
         let key = e.time.key();
         let idx = match self.free_events.pop() {
@@ -469,7 +467,7 @@ impl<'a> Flipper<'a> {
                 (self.events.len() - 1) as u32
             }
         };
-        self.heap.push((key, idx));
+        self.heap.push((key, idx, forced));
         let mut k = self.heap.len() - 1;
         while k > 0 {
             let parent = (k - 1) / 2;
@@ -486,7 +484,7 @@ impl<'a> Flipper<'a> {
         if self.heap.is_empty() {
             return None;
         }
-        let (_, top) = self.heap.swap_remove(0);
+        let (_, top, _) = self.heap.swap_remove(0);
         let n = self.heap.len();
         let mut k = 0;
         loop {
@@ -508,20 +506,19 @@ impl<'a> Flipper<'a> {
     }
 
     /// Does heap entry `a` come strictly before heap entry `b`?
-    fn earlier(&mut self, (ka, a): (TimeKey, u32), (kb, b): (TimeKey, u32)) -> bool {
+    fn earlier(
+        &mut self,
+        (ka, a, fa): (TimeKey, u32, bool),
+        (kb, b, fb): (TimeKey, u32, bool),
+    ) -> bool {
+        if fa || fb {
+            return if fa == fb { a < b } else { fa };
+        }
+        if let Some(s) = key_cross(&ka, &kb) {
+            self.cmp.filtered += 1;
+            return s < 0;
+        }
         let (ea, eb) = (&self.events[a as usize], &self.events[b as usize]);
-        if !ea.forced && !eb.forced {
-            if let Some(s) = key_cross(&ka, &kb) {
-                self.cmp.filtered += 1;
-                return s < 0;
-            }
-        }
-        if ea.forced != eb.forced {
-            return ea.forced;
-        }
-        if ea.forced {
-            return a < b;
-        }
         match cross_sign(&ea.time, &eb.time, &self.lift, &mut self.cmp) {
             0 => a < b,
             s => s < 0,
