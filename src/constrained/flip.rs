@@ -126,6 +126,13 @@ pub fn insert_region(
         Some(Problem::Stuck)
     };
     drop(fl);
+    if debug() {
+        eprintln!(
+            "facet {facet}: {} crossing tets, {} flips, problem {problem:?}",
+            crossing.len(),
+            counts.total()
+        );
+    }
     let flat = region
         .verts
         .iter()
@@ -133,7 +140,15 @@ pub fn insert_region(
     match problem {
         None => {}
         Some(Problem::Shim(f)) | Some(Problem::NotDelaunay(f)) if !flat => {
-            return Ok(Outcome::NeedsSteiner(steiner_point(cdt, tris, f, normal)));
+            // The point goes on the polygon, at the region triangle nearest the trouble.
+            let near = tris
+                .iter()
+                .max_by_key(|t| t.iter().filter(|x| f.contains(x)).count())
+                .copied()
+                .unwrap_or(f);
+            return Ok(Outcome::NeedsSteiner(steiner_point(
+                cdt, tris, near, normal,
+            )));
         }
         Some(p) => {
             if debug() {
@@ -773,7 +788,8 @@ impl<'a> Flipper<'a> {
         Ok(None)
     }
 
-    /// Is face `f` (between two live tets of R, not a constraint) not locally Delaunay?
+    /// Is face `f` (of a live tet of R, not a constraint, not on the hull) not locally
+    /// Delaunay?
     fn not_delaunay(&mut self, f: FaceRef) -> bool {
         let mesh = &self.cdt.dt.mesh;
         let t = f.tet();
@@ -781,7 +797,9 @@ impl<'a> Flipper<'a> {
             return false;
         }
         let g = mesh.adj(f);
-        if !self.in_r.contains(&g.tet()) {
+        // Faces on R's boundary count too: flips there are refused (safeguard 1), so
+        // such a face becomes a problem for the region instead of passing silently.
+        if mesh.is_ghost(g.tet()) {
             return false;
         }
         let s = mesh.face_verts(t, f.face());

@@ -313,8 +313,7 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         counts.filtered += 1;
         return s;
     }
-    if a
-        .ids
+    if a.ids
         .iter()
         .all(|&id| b.ids.contains(&id) && left_of(a, id) == left_of(b, id))
     {
@@ -377,7 +376,8 @@ pub fn key_cross(a: &TimeKey, b: &TimeKey) -> Option<i32> {
         + 4.0 * f64::EPSILON * (x.abs() + y.abs()))
         * (1.0 + 1e-12);
     // NaN bounds (out of range) fail both tests below.
-    if !(bound < f64::MAX) || (bound < 1e-290 && s != 0.0) {
+    // NaN (out of the analysed range), overflow, or possible underflow: undecided.
+    if !(1e-290..f64::MAX).contains(&bound) {
         return None;
     }
     if s > bound {
@@ -393,27 +393,7 @@ pub fn key_cross(a: &TimeKey, b: &TimeKey) -> Option<i32> {
 /// settle it.
 #[inline]
 fn filtered_cross(a: &FlipTime, b: &FlipTime) -> Option<i32> {
-    let (eia, eja, eib, ejb) = (a.i.err()?, a.j.err()?, b.i.err()?, b.j.err()?);
-    let (x, y) = (b.i.v * a.j.v, a.i.v * b.j.v);
-    let s = x - y;
-    // |Îb·Ĵa − Ib·Ja| ≤ eIb·(|Ĵa| + eJa) + |Îb|·eJa, likewise for the other product, plus
-    // the rounding of the two products and the difference.
-    let bound = (eib * (a.j.v.abs() + eja)
-        + b.i.v.abs() * eja
-        + eia * (b.j.v.abs() + ejb)
-        + a.i.v.abs() * ejb
-        + 4.0 * f64::EPSILON * (x.abs() + y.abs()))
-        * (1.0 + 1e-12);
-    if !(bound < f64::MAX) || bound < 1e-290 && s != 0.0 {
-        return None;
-    }
-    if s > bound {
-        Some(1)
-    } else if -s > bound {
-        Some(-1)
-    } else {
-        None
-    }
+    key_cross(&a.key(), &b.key())
 }
 
 fn left_of(f: &FlipTime, id: u32) -> bool {
