@@ -27,7 +27,7 @@ use crate::geom::lifted::{
 };
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
 use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 
 /// Figures of flip insertion, summed over regions.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -234,6 +234,75 @@ fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
     [a, b, c]
 }
 
+/// Scratch arrays indexed by vertex and tet id, valid where their stamp is the current
+/// one: per-region hash maps cost more than the flips themselves, and clearing arrays
+/// the size of the mesh for every region would cost more still.
+#[derive(Default)]
+struct Marks {
+    stamp: u32,
+    vert_stamp: Vec<u32>,
+    vert: Vec<(i8, Approx)>,
+    tet_stamp: Vec<u32>,
+}
+
+thread_local! {
+    static MARKS: std::cell::RefCell<Marks> = std::cell::RefCell::new(Marks::default());
+}
+
+impl Marks {
+    /// Starts a region: a fresh stamp, arrays large enough for the mesh.
+    fn next_stamp(&mut self, verts: usize, tets: usize) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.vert_stamp.iter_mut().for_each(|x| *x = 0);
+            self.tet_stamp.iter_mut().for_each(|x| *x = 0);
+            self.stamp = 1;
+        }
+        if self.vert_stamp.len() < verts {
+            self.vert_stamp.resize(verts, 0);
+            self.vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
+        }
+        if self.tet_stamp.len() < tets {
+            self.tet_stamp.resize(tets, 0);
+        }
+    }
+
+    #[inline]
+    fn side(&self, v: VertexId) -> Option<(i8, Approx)> {
+        (self.vert_stamp.get(v as usize) == Some(&self.stamp)).then(|| self.vert[v as usize])
+    }
+
+    fn set_side(&mut self, v: VertexId, side: i8, h: Approx) {
+        self.vert_stamp[v as usize] = self.stamp;
+        self.vert[v as usize] = (side, h);
+    }
+
+    #[inline]
+    fn has_tet(&self, t: TetId) -> bool {
+        self.tet_stamp.get(t as usize) == Some(&self.stamp)
+    }
+
+    fn add_tet(&mut self, t: TetId) {
+        if self.tet_stamp.len() <= t as usize {
+            self.tet_stamp.resize(t as usize + 1, 0);
+        }
+        self.tet_stamp[t as usize] = self.stamp;
+    }
+
+    fn remove_tet(&mut self, t: TetId) {
+        if let Some(x) = self.tet_stamp.get_mut(t as usize) {
+            *x = 0;
+        }
+    }
+}
+
+impl Drop for Flipper<'_> {
+    fn drop(&mut self) {
+        let marks = std::mem::take(&mut self.marks);
+        MARKS.with(|m| *m.borrow_mut() = marks);
+    }
+}
+
 /// What keeps a finished region from being a CDT.
 #[derive(Clone, Copy, Debug)]
 enum Problem {
@@ -250,11 +319,11 @@ struct Flipper<'a> {
     cdt: &'a mut Cdt,
     region: &'a Region,
     lift: Lifting,
-    /// Side of each vertex of R (1 left, weighted; -1 right; 0 on the polygon), and
-    /// its height.
-    side: FxHashMap<VertexId, (i8, Approx)>,
-    /// The tets of R (they change as flips replace them).
-    in_r: FxHashSet<TetId>,
+    /// Per-vertex sides and heights, and the membership of tets in R (they change as
+    /// flips replace them), in arrays stamped for this region.
+    marks: Marks,
+    /// The tets put in R (some since flipped away: filter with `in_r`).
+    r_list: Vec<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
     events: Vec<Event>,
     /// Event slots free for reuse.
@@ -275,26 +344,28 @@ struct Flipper<'a> {
 
 impl<'a> Flipper<'a> {
     fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
-        let mut side = FxHashMap::default();
+        let mut marks = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
+        marks.next_stamp(cdt.dt.points.len(), cdt.dt.mesh.num_slots());
         for &t in crossing {
+            marks.add_tet(t);
             for v in cdt.dt.mesh.verts(t) {
-                side.entry(v).or_insert_with(|| {
+                if marks.side(v).is_none() {
                     let p = &cdt.dt.points[v as usize];
                     let s = if region.verts.contains(&v) {
                         0
                     } else {
                         lift.side(p) as i8
                     };
-                    (s, lift.height_approx(p, s == 1))
-                });
+                    marks.set_side(v, s, lift.height_approx(p, s == 1));
+                }
             }
         }
         Flipper {
             cdt,
             region,
             lift,
-            side,
-            in_r: crossing.iter().copied().collect(),
+            marks,
+            r_list: crossing.to_vec(),
             region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
             events: Vec::new(),
             free_events: Vec::new(),
@@ -310,13 +381,13 @@ impl<'a> Flipper<'a> {
     /// Flips until no crossing triangle is left; true if the region's triangles are then
     /// all mesh faces.
     fn run(&mut self) -> Result<bool, MeshError> {
-        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        let mut r = self.tets_of_r();
         r.sort_unstable();
         for &t in &r {
             for i in 0..4 {
                 let f = FaceRef::new(t, i);
                 let n = self.cdt.dt.mesh.adj(f).tet();
-                if t < n && self.in_r.contains(&n) {
+                if t < n && self.in_r(n) {
                     self.certify(f);
                 }
             }
@@ -396,7 +467,7 @@ impl<'a> Flipper<'a> {
             for i in 0..4 {
                 let f = FaceRef::new(t, i);
                 let g = self.cdt.dt.mesh.adj(f);
-                if !self.in_r.contains(&g.tet()) {
+                if !self.in_r(g.tet()) {
                     continue;
                 }
                 let fv = self.cdt.dt.mesh.face_verts(t, i);
@@ -427,11 +498,26 @@ impl<'a> Flipper<'a> {
         }
     }
 
+    /// Is tet `t` in R?
+    #[inline]
+    fn in_r(&self, t: TetId) -> bool {
+        self.marks.has_tet(t)
+    }
+
+    /// The tets of R now, without repeats.
+    fn tets_of_r(&mut self) -> Vec<TetId> {
+        let mut r: Vec<TetId> = self.r_list.iter().copied().filter(|&t| self.in_r(t)).collect();
+        r.sort_unstable();
+        r.dedup();
+        self.r_list = r.clone();
+        r
+    }
+
     fn is_crossing(&self, verts: &[VertexId]) -> bool {
         let mut l = false;
         let mut r = false;
         for v in verts {
-            match self.side.get(v) {
+            match self.marks.side(*v) {
                 Some((1, _)) => l = true,
                 Some((-1, _)) => r = true,
                 _ => {}
@@ -451,7 +537,7 @@ impl<'a> Flipper<'a> {
         let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
         let zero = Approx { v: 0.0, p: 0.0 };
-        let sh = ids.map(|x| self.side.get(&x).copied().unwrap_or((0, zero)));
+        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
         FlipTime::new(pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
     }
 
@@ -549,8 +635,8 @@ impl<'a> Flipper<'a> {
             && mesh.verts(t1) == ev.t1
             && mesh.is_alive(t2)
             && mesh.verts(t2) == ev.t2
-            && self.in_r.contains(&t1)
-            && self.in_r.contains(&t2)
+            && self.in_r(t1)
+            && self.in_r(t2)
     }
 
     /// Removes face `f` by a 2-3, 3-2 or 4-4 flip, if the tets around it allow one and
@@ -648,7 +734,7 @@ impl<'a> Flipper<'a> {
             } else {
                 return Ok(Err(Refusal::NotFlippable));
             };
-        if old.iter().any(|t| !self.in_r.contains(t)) {
+        if old.iter().any(|&t| !self.in_r(t)) {
             return Ok(Err(Refusal::OutsideR));
         }
         let made = self.replace(&old, &new)?;
@@ -693,7 +779,7 @@ impl<'a> Flipper<'a> {
         }
         for &t in old {
             mesh.kill_tet(t);
-            self.in_r.remove(&t);
+            self.marks.remove_tet(t);
         }
         let mut made = Vec::with_capacity(new.len());
         for &v in new {
@@ -732,7 +818,8 @@ impl<'a> Flipper<'a> {
             for x in mesh.verts(t) {
                 mesh.set_vertex_tet(x, t);
             }
-            self.in_r.insert(t);
+            self.marks.add_tet(t);
+            self.r_list.push(t);
         }
         Ok(made)
     }
@@ -741,7 +828,7 @@ impl<'a> Flipper<'a> {
     /// where a flip keeping the region can, and reports a shim or a face that remains.
     fn repair(&mut self) -> Result<Option<Problem>, MeshError> {
         let mut work: Vec<FaceRef> = Vec::new();
-        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        let mut r = self.tets_of_r();
         r.sort_unstable();
         for &t in &r {
             for i in 0..4 {
@@ -777,7 +864,7 @@ impl<'a> Flipper<'a> {
                 )));
             }
         }
-        let mut r: Vec<TetId> = self.in_r.iter().copied().collect();
+        let mut r = self.tets_of_r();
         r.sort_unstable();
         for t in r {
             let v = self.cdt.dt.mesh.verts(t);
@@ -793,7 +880,7 @@ impl<'a> Flipper<'a> {
     fn not_delaunay(&mut self, f: FaceRef) -> bool {
         let mesh = &self.cdt.dt.mesh;
         let t = f.tet();
-        if !mesh.is_alive(t) || !self.in_r.contains(&t) {
+        if !mesh.is_alive(t) || !self.in_r(t) {
             return false;
         }
         let g = mesh.adj(f);
