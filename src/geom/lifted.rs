@@ -144,11 +144,21 @@ pub fn orient<T: Arith>(a: &Point, b: &Point, c: &Point, d: &Point) -> T {
 /// coordinate differences and lifts already relative to `p_4`. With `l_i = |p_i − p_4|²`
 /// this is Shewchuk's insphere.
 fn lifted_det<T: Arith>(d: &[[T; 3]; 4], l: &[T; 4]) -> T {
+    with_minors(&minors(d), l)
+}
+
+/// The four 3×3 minors of the coordinate columns, `m[i]` without row `i`.
+fn minors<T: Arith>(d: &[[T; 3]; 4]) -> [T; 4] {
     let m = |a: usize, b: usize, c: usize| det3([&d[a], &d[b], &d[c]]);
-    l[3].times(&m(0, 1, 2))
-        .minus(&l[2].times(&m(0, 1, 3)))
-        .plus(&l[1].times(&m(0, 2, 3)))
-        .minus(&l[0].times(&m(1, 2, 3)))
+    [m(1, 2, 3), m(0, 2, 3), m(0, 1, 3), m(0, 1, 2)]
+}
+
+/// [`lifted_det`] from precomputed minors (`I` and `J` share them).
+fn with_minors<T: Arith>(m: &[T; 4], l: &[T; 4]) -> T {
+    l[3].times(&m[3])
+        .minus(&l[2].times(&m[2]))
+        .plus(&l[1].times(&m[1]))
+        .minus(&l[0].times(&m[0]))
 }
 
 /// Coordinate differences of the first four points from the fifth.
@@ -158,19 +168,29 @@ fn rows<T: Arith>(p: &[Point; 5]) -> [[T; 3]; 4] {
 
 /// `I`: our insphere (positive inside) of the tet `p[0..4]` and the query `p[4]`.
 fn insphere_value<T: Arith>(d: &[[T; 3]; 4]) -> T {
+    insphere_with(d, &minors(d))
+}
+
+fn insphere_with<T: Arith>(d: &[[T; 3]; 4], m: &[T; 4]) -> T {
     let l: [T; 4] = std::array::from_fn(|i| {
         d[i][0]
             .times(&d[i][0])
             .plus(&d[i][1].times(&d[i][1]))
             .plus(&d[i][2].times(&d[i][2]))
     });
-    T::constant(0.0).minus(&lifted_det(d, &l))
+    T::constant(0.0).minus(&with_minors(m, &l))
 }
 
 /// `J`: the insphere determinant with the lift replaced by the heights `h`.
-fn height_value<T: Arith>(d: &[[T; 3]; 4], h: &[T; 5]) -> T {
+fn height_with<T: Arith>(m: &[T; 4], h: &[T; 5]) -> T {
     let l: [T; 4] = std::array::from_fn(|i| h[i].minus(&h[4]));
-    T::constant(0.0).minus(&lifted_det(d, &l))
+    T::constant(0.0).minus(&with_minors(m, &l))
+}
+
+/// `I` and `J` together, sharing the minors.
+fn both_values<T: Arith>(d: &[[T; 3]; 4], h: &[T; 5]) -> (T, T) {
+    let m = minors(d);
+    (insphere_with(d, &m), height_with(&m, h))
 }
 
 /// The coefficient of the perturbation weight of point `k` in `D`: the determinant with
@@ -264,12 +284,13 @@ impl FlipTime {
     /// given the points' heights ([`Lifting::height_approx`], zero unless left).
     pub fn new(pts: [Point; 5], ids: [u32; 5], left: [bool; 5], h: [Approx; 5]) -> Self {
         let d: [[Approx; 3]; 4] = rows(&pts);
+        let (i, j) = both_values(&d, &h);
         FlipTime {
             pts,
             ids,
             left,
-            i: insphere_value(&d),
-            j: height_value(&d, &h),
+            i,
+            j,
             exact: OnceCell::new(),
         }
     }
@@ -279,7 +300,7 @@ impl FlipTime {
             let d: [[Expansion; 3]; 4] = rows(&self.pts);
             let h: [Expansion; 5] =
                 std::array::from_fn(|k| lift.height(&self.pts[k], self.left[k]));
-            Box::new((insphere_value(&d), height_value(&d, &h)))
+            Box::new(both_values(&d, &h))
         })
     }
 
