@@ -506,7 +506,12 @@ impl<'a> Flipper<'a> {
 
     /// The tets of R now, without repeats.
     fn tets_of_r(&mut self) -> Vec<TetId> {
-        let mut r: Vec<TetId> = self.r_list.iter().copied().filter(|&t| self.in_r(t)).collect();
+        let mut r: Vec<TetId> = self
+            .r_list
+            .iter()
+            .copied()
+            .filter(|&t| self.in_r(t))
+            .collect();
         r.sort_unstable();
         r.dedup();
         self.r_list = r.clone();
@@ -899,5 +904,75 @@ impl<'a> Flipper<'a> {
         let p = ids.map(|x| &self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
         insphere_sos(p, orig) == Sign::Positive
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::delaunay::Delaunay;
+
+    fn lcg(s: &mut u64) -> f64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*s >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Points near the plane z = 0 and a big triangle in it, as the Figure 9 experiment:
+    /// inserted by flips, the result is a valid arena, keeps every vertex, has the
+    /// triangle as a face, and every other face is locally Delaunay (a CDT).
+    #[test]
+    fn flips_insert_a_triangle_into_random_points() {
+        for seed in 0..6u64 {
+            let mut s = seed * 7919 + 1;
+            // Far enough out that its edges are hull edges (the driver recovers them).
+            let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
+            while pts.len() < 150 {
+                let z = 0.2 * lcg(&mut s) - 0.1;
+                if z != 0.0 {
+                    pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
+                }
+            }
+            let dt = Delaunay::build(&pts).unwrap().dt;
+            let inv = dt.internal_ids(pts.len());
+            let mut cdt = Cdt::new(dt);
+            let tri = [inv[0], inv[1], inv[2]];
+            for k in 0..3 {
+                assert!(cdt.has_edge(tri[k], tri[(k + 1) % 3]));
+            }
+            let out = insert_region(&mut cdt, &[tri], 0, [0.0, 0.0, 1.0]).unwrap();
+            let Outcome::Inserted(rs) = out else {
+                panic!("seed {seed}: {out:?}");
+            };
+            assert_eq!(rs.flips.fallbacks, 0, "seed {seed}");
+            assert!(rs.flips.total() > 0 && rs.crossing_tets > 10, "seed {seed}");
+            cdt.dt.mesh.check_links().unwrap();
+            assert!(cdt.find_face(tri[0], tri[1], tri[2]).is_some());
+            let mut used = vec![false; pts.len()];
+            let key = face_key(tri);
+            for t in cdt.dt.mesh.real_tets().collect::<Vec<_>>() {
+                let v = cdt.dt.mesh.verts(t);
+                let p = v.map(|x| &cdt.dt.points[x as usize]);
+                assert!(orient3d(p[0], p[1], p[2], p[3]) > 0.0);
+                for &x in &v {
+                    used[x as usize] = true;
+                }
+                for i in 0..4 {
+                    let g = cdt.dt.mesh.adj(FaceRef::new(t, i));
+                    if cdt.dt.mesh.is_ghost(g.tet())
+                        || face_key(cdt.dt.mesh.face_verts(t, i)) == key
+                    {
+                        continue;
+                    }
+                    let w = cdt.dt.mesh.verts(g.tet())[g.face()];
+                    let ids = [v[0], v[1], v[2], v[3], w];
+                    let q = ids.map(|x| &cdt.dt.points[x as usize]);
+                    let o = ids.map(|x| cdt.dt.orig[x as usize]);
+                    assert_ne!(insphere_sos(q, o), Sign::Positive, "seed {seed}");
+                }
+            }
+            assert!(used.iter().all(|&u| u), "seed {seed}: a vertex was lost");
+        }
     }
 }
