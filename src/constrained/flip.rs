@@ -472,7 +472,10 @@ impl<'a> Flipper<'a> {
                 }
                 let fv = self.cdt.dt.mesh.face_verts(t, i);
                 if self.is_crossing(&fv) {
-                    self.certify(f);
+                    // A face between two new tets: certified once, from the lower id.
+                    if g.tet() > t || !new.contains(&g.tet()) {
+                        self.certify(f);
+                    }
                     continue;
                 }
                 if crossing_tet || self.is_crossing(&self.cdt.dt.mesh.verts(g.tet())) {
