@@ -534,6 +534,22 @@ impl<'a> Flipper<'a> {
         l && r
     }
 
+    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last),
+    /// if it ever flips.
+    fn flip_time_if_flips(&self, f: FaceRef) -> Option<FlipTime> {
+        let mesh = &self.cdt.dt.mesh;
+        let g = mesh.adj(f);
+        let s = mesh.face_verts(f.tet(), f.face());
+        let v = mesh.verts(f.tet())[f.face()];
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [s[0], s[1], s[2], v, w];
+        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        let zero = Approx { v: 0.0, p: 0.0 };
+        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
+        FlipTime::if_flips(&self.lift, pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+    }
+
     /// The flip certificate of face `f` (seen from its tet, apex of the other tet last).
     fn flip_time(&self, f: FaceRef) -> FlipTime {
         let mesh = &self.cdt.dt.mesh;
@@ -551,8 +567,7 @@ impl<'a> Flipper<'a> {
 
     /// Queues the flip of crossing face `f` if it ever happens.
     fn certify(&mut self, f: FaceRef) {
-        let time = self.flip_time(f);
-        if time.flips(&self.lift) {
+        if let Some(time) = self.flip_time_if_flips(f) {
             self.push_event(f, time, false);
         }
     }

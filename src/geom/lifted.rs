@@ -295,6 +295,33 @@ impl FlipTime {
         }
     }
 
+    /// The certificate if the face ever flips (`J > 0`), else `None`; cheaper than
+    /// [`FlipTime::new`] followed by [`FlipTime::flips`] when `J` is surely not positive,
+    /// since `I` is then never computed.
+    pub fn if_flips(
+        lift: &Lifting,
+        pts: [Point; 5],
+        ids: [u32; 5],
+        left: [bool; 5],
+        h: [Approx; 5],
+    ) -> Option<Self> {
+        let d: [[Approx; 3]; 4] = rows(&pts);
+        let m = minors(&d);
+        let j = height_with(&m, &h);
+        if matches!(j.sign(), Some(s) if s <= 0) {
+            return None;
+        }
+        let t = FlipTime {
+            pts,
+            ids,
+            left,
+            i: insphere_with(&d, &m),
+            j,
+            exact: OnceCell::new(),
+        };
+        t.flips(lift).then_some(t)
+    }
+
     fn exact(&self, lift: &Lifting) -> &(Expansion, Expansion) {
         self.exact.get_or_init(|| {
             let d: [[Expansion; 3]; 4] = rows(&self.pts);
