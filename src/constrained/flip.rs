@@ -116,15 +116,16 @@ pub fn insert_region(
     };
     let mut fl = Flipper::new(cdt, &region, lift, &crossing);
     let done = fl.run()?;
-    let mut counts = fl.counts;
-    counts.exact_compares = fl.cmp.exact;
-    counts.perturbed_compares = fl.cmp.perturbed;
-    let mut at_risk = std::mem::take(&mut fl.at_risk);
     let problem = if done {
         fl.repair()?
     } else {
         Some(Problem::Stuck)
     };
+    // Taken after the repair, whose flips count and may destroy subfaces too.
+    let mut counts = fl.counts;
+    counts.exact_compares = fl.cmp.exact;
+    counts.perturbed_compares = fl.cmp.perturbed;
+    let mut at_risk = std::mem::take(&mut fl.at_risk);
     drop(fl);
     if debug() {
         eprintln!(
