@@ -109,6 +109,10 @@ impl Stats {
                     format!("{} / {}", f.exact_compares, f.perturbed_compares),
                 ),
                 ("    fallbacks to cavity retriangulation", fallbacks),
+                (
+                    "    hand-overs for polygons not flat",
+                    f.not_flat_handovers.to_string(),
+                ),
             ]);
         }
         rows.extend([
@@ -167,7 +171,7 @@ impl Stats {
             ];
             fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
             let f = &p.flips;
-            let flips: [(&str, usize); 11] = [
+            let flips: [(&str, usize); 12] = [
                 ("flips", f.total()),
                 ("flips_2_3", f.flips23),
                 ("flips_3_2", f.flips32),
@@ -179,6 +183,7 @@ impl Stats {
                 ("flips_refused_by_constraints", f.constrained),
                 ("exact_flip_time_compares", f.exact_compares),
                 ("flip_fallbacks", f.fallbacks),
+                ("flip_not_flat_handovers", f.not_flat_handovers),
             ];
             fields.extend(
                 flips

@@ -29,8 +29,6 @@ pub struct RegionStats {
     pub enlarged_tets: usize,
     /// Subfaces recovered (triangles of the region).
     pub subfaces: usize,
-    /// Flip insertion's figures (zero for cavity retriangulation).
-    pub flips: super::flip::FlipCounts,
 }
 
 /// What inserting a region did.
@@ -204,7 +202,6 @@ pub fn insert_region(
         crossing_tets: crossing,
         enlarged_tets: enlarged,
         subfaces: tris.len(),
-        ..Default::default()
     }))
 }
 

@@ -53,17 +53,18 @@ pub enum FacetInserter {
 }
 
 impl FacetInserter {
-    /// Inserts the region `tris` of facet `facet`.
+    /// Inserts the region `tris` of facet `facet` (flips add their figures to `flips`).
     pub fn insert(
         self,
         cdt: &mut Cdt,
         tris: &[[VertexId; 3]],
         facet: u32,
         normal: [f64; 3],
+        flips: &mut flip::FlipCounts,
     ) -> Result<Outcome, MeshError> {
         match self {
             FacetInserter::Cavity => insert_region(cdt, tris, facet, normal),
-            FacetInserter::Flip => flip::insert_region(cdt, tris, facet, normal),
+            FacetInserter::Flip => flip::insert_region(cdt, tris, facet, normal, flips),
         }
     }
 }
@@ -411,15 +412,15 @@ fn attempt(
             }
         }
         for region in regions_of(&missing, &seg_markers) {
-            match opts
-                .inserter
-                .insert(&mut cdt, &region, fi as u32, f.normal)?
-            {
+            let fallbacks = stats.flips.fallbacks;
+            let outcome =
+                opts.inserter
+                    .insert(&mut cdt, &region, fi as u32, f.normal, &mut stats.flips)?;
+            if stats.flips.fallbacks > fallbacks {
+                stats.flip_fallback_facets.push(fi as u32);
+            }
+            match outcome {
                 Outcome::Inserted(rs) => {
-                    stats.flips.add(&rs.flips);
-                    if rs.flips.fallbacks > 0 {
-                        stats.flip_fallback_facets.push(fi as u32);
-                    }
                     stats.regions += 1;
                     stats.recovered_subfaces += rs.subfaces;
                     stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);
