@@ -3,7 +3,8 @@
 
 usage: fig9.py FIG9.CSV OUT.PNG
 
-Left panel: every size; right panel: up to 2,000 crossing tets (the paper's range).
+Left panel: every size; right panel: up to 2,000 crossing tets (the paper's range). The
+y axis is scaled to the other three series: TetGen -L, far slower, is clipped at the top.
 Time in milliseconds against crossing tets, for our -C and -F and TetGen's -pcO0 (cavity)
 and -pcLO0 (flips). Uses matplotlib when it is installed, else draws the PNG itself (a
 plain raster with a small built-in font). Prints a summary: the least-squares line of
@@ -106,6 +107,10 @@ def plot_matplotlib(data, out):
             if pts:
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=name,
                         color=tuple(c / 255 for c in color), markersize=3)
+        others = [p[1] for name, _, _ in SERIES[:3] for p in data[name]
+                  if limit is None or p[0] <= limit]
+        if others:
+            ax.set_ylim(0, 1.3 * max(others))
         ax.set_xlabel("crossing tetrahedra deleted")
         ax.set_ylabel("time to insert the rectangle (ms)")
         ax.grid(alpha=0.3)
@@ -195,11 +200,14 @@ def panel(cv, data, x0, y0, w, h, limit, title):
     if not pts_all:
         return
     xmax = max(p[0] for p in pts_all) * 1.05
-    ymax = max(p[1] for p in pts_all) * 1.05
+    # Scaled to ours and TetGen -C; TetGen -L is clipped at the top.
+    others = [p[1] for name, _, _ in SERIES[:3] for p in data[name]
+              if limit is None or p[0] <= limit] or [p[1] for p in pts_all]
+    ymax = max(others) * 1.3
     def tx(x):
         return round(x0 + x / xmax * w)
     def ty(y):
-        return round(y0 + h - y / ymax * h)
+        return round(y0 + h - min(y, ymax) / ymax * h)
     for t in nice_ticks(xmax):
         cv.line(tx(t), y0, tx(t), y0 + h, (230, 230, 230))
         cv.text(tx(t) - 8, y0 + h + 8, fmt(t))
@@ -223,7 +231,7 @@ def panel(cv, data, x0, y0, w, h, limit, title):
 
 def plot_raster(data, out):
     cv = Canvas(1200, 520)
-    panel(cv, data, 90, 60, 460, 380, None, "FIGURE 9: ALL SIZES")
+    panel(cv, data, 90, 60, 460, 380, None, "FIGURE 9: ALL SIZES (TETGEN -L CLIPPED)")
     panel(cv, data, 690, 60, 460, 380, 2000, "UP TO 2000 CROSSING TETS")
     cv.save(out)
 

@@ -7,7 +7,8 @@
 #
 # Environment: SIZES (point counts, default 100 ... 40000), SEED (default 1), REPEAT (runs
 # of ours per size, the fastest kept; default 3), TETGEN_TIMEOUT (seconds per TetGen run,
-# default 300), TETCDT_TOOLS (directory of gen_fig9.py, default ../shared/tools).
+# default 300), TETGEN_L_MAX (largest point count for TetGen's flips, which are far
+# slower; default 30000), TETCDT_TOOLS (directory of gen_fig9.py, default ../shared/tools).
 #
 # Inputs come from gen_fig9.py (points in [-1,1]^2 x [-0.1,0.1], the rectangle
 # [-2,2]^2 x {0}); meshes keep the hull (-c) since one rectangle encloses no volume.
@@ -19,10 +20,11 @@ set -uo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="${1:-$ROOT/fig9}"
-SIZES="${SIZES:-100 200 300 500 700 1000 1500 2000 3000 5000 7000 10000 15000 20000 30000 40000}"
+SIZES="${SIZES:-100 150 200 300 400 500 700 1000 1500 2000 3000 5000 7000 10000 15000 20000 30000 40000}"
 SEED="${SEED:-1}"
 REPEAT="${REPEAT:-3}"
 TETGEN_TIMEOUT="${TETGEN_TIMEOUT:-300}"
+TETGEN_L_MAX="${TETGEN_L_MAX:-30000}"
 GEN=""
 for dir in "${TETCDT_TOOLS:-}" "$ROOT/../shared/tools" /work/shared/tools; do
     if [[ -n "$dir" && -f "$dir/gen_fig9.py" ]]; then
@@ -87,7 +89,8 @@ for n in $SIZES; do
         crossing=$(field "$WORK/sC.json" crossing_tets)
     fi
     tc=$(tetgen_secs -pcO0V)
-    tl=$(tetgen_secs -pcLO0V)
+    tl=""
+    ((n <= TETGEN_L_MAX)) && tl=$(tetgen_secs -pcLO0V)
     echo "$n,$crossing,$c_secs,$c_status,$f_secs,$f_status,$flips,$fallbacks,$tc,$tl" >>"$CSV"
     echo "n=$n crossing=$crossing -C=${c_secs:-$c_status} -F=${f_secs:-$f_status} tetgen=$tc tetgen-L=$tl" >&2
 done
