@@ -280,6 +280,7 @@ UNSUPPORTED_LIST=()
 MORE_STEINER=()
 
 n_flip=0 n_flip_valid=0 n_flip_ident_cases=0 n_flip_ident=0 n_flip_fallbacks=0 sum_t_flip=0
+sum_t_cav=0
 FLIP_PROBLEMS=()
 
 # Sets FCOL, the -F column of the current model: Steiner points, valid, equal to -C,
@@ -301,6 +302,7 @@ flip_column() {
         return 0
     fi
     sum_t_flip="$(awk -v a="$sum_t_flip" -v b="$ftime" 'BEGIN { printf "%.3f", a + b }')"
+    sum_t_cav="$(awk -v a="$sum_t_cav" -v b="$our_time" 'BEGIN { printf "%.3f", a + b }')"
     if validator_reads "$name"; then
         python3 "$VALIDATOR" "$input" "$dir/flip" >"$dir/validate_flip.out" 2>&1
     else
@@ -508,7 +510,7 @@ if [[ $n_both -gt 0 ]]; then
 fi
 [[ ${#MORE_STEINER[@]} -gt 0 ]] && echo "- we add Steiner points where TetGen adds none: ${MORE_STEINER[*]}"
 if [[ $USE_FLIP == 1 ]]; then
-    echo "- -F (flips): valid **$n_flip_valid / $n_flip**; tets equal to -C where neither adds Steiner points **$n_flip_ident / $n_flip_ident_cases**; regions that fell back to cavities **$n_flip_fallbacks**; time total **${sum_t_flip} s** (-C: ${sum_t_ours} s over the models TetGen also meshed)"
+    echo "- -F (flips): valid **$n_flip_valid / $n_flip**; tets equal to -C where neither adds Steiner points **$n_flip_ident / $n_flip_ident_cases**; regions that fell back to cavities **$n_flip_fallbacks**; wall time over the models -F meshed: -F **${sum_t_flip} s**, -C **${sum_t_cav} s**"
 fi
 [[ ${#SKIPPED_NO_TSV[@]} -gt 0 ]] && echo "- not in tetgen_p_O0.tsv (TetGen cannot read them), skipped: ${SKIPPED_NO_TSV[*]}"
 [[ $ALL == 0 && ${#PATTERNS[@]} == 0 ]] && echo "- tetgen_stp/ skipped (use --all)"
