@@ -7,6 +7,7 @@
 #   --keep       keep the work directory (printed on stderr) instead of deleting it
 #   --no-build   do not run `cargo build --release` first
 #   --no-tetgen  do not run TetGen even if installed: use tetgen_p_O0.tsv's figures
+#   --no-flip    do not run facet insertion by flips (-F) for the -F column
 #   PATTERN      only models whose corpus path contains one of the patterns
 #
 # Environment: CORPUS (default ../shared/corpus relative to the repository: the directory
@@ -26,6 +27,9 @@
 #     is kept); the tsv fallback uses the node count minus the distinct vertex count;
 #   - where neither mesh has Steiner points, the two tet sets are compared exactly, nodes
 #     mapped by coordinates; when they differ, TetGen's own mesh is validated too.
+#   - the -F column: `tetcdt -pQF`, timed and validated the same way, its Steiner points,
+#     whether its tets equal -C's (where neither adds Steiner points) and how many regions
+#     fell back from flips to cavity retriangulation (from --stats-json).
 # Where TetGen's mesh is empty (an open surface: everything carved away) we must exit 3.
 # Formats tetcdt does not read (exit 3, "unknown input format") get a row saying so.
 #
@@ -39,6 +43,7 @@ ALL=0
 KEEP=0
 BUILD=1
 USE_TETGEN=1
+USE_FLIP=1
 PATTERNS=()
 for arg in "$@"; do
     case "$arg" in
@@ -46,6 +51,7 @@ for arg in "$@"; do
         --keep) KEEP=1 ;;
         --no-build) BUILD=0 ;;
         --no-tetgen) USE_TETGEN=0 ;;
+        --no-flip) USE_FLIP=0 ;;
         -h|--help) sed -n '2,/^set -uo/p' "${BASH_SOURCE[0]}" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
         -*) echo "corpus.sh: unknown option $arg" >&2; exit 2 ;;
         *) PATTERNS+=("$arg") ;;
@@ -273,6 +279,57 @@ sum_st_ours=0 sum_st_tg=0 sum_t_ours=0 sum_t_tg=0 n_both=0
 UNSUPPORTED_LIST=()
 MORE_STEINER=()
 
+n_flip=0 n_flip_valid=0 n_flip_ident_cases=0 n_flip_ident=0 n_flip_fallbacks=0 sum_t_flip=0
+sum_t_cav=0
+FLIP_PROBLEMS=()
+
+# Sets FCOL, the -F column of the current model: Steiner points, valid, equal to -C,
+# fallbacks, time.
+flip_column() {
+    FCOL="–"
+    [[ $USE_FLIP == 1 ]] || return 0
+    n_flip=$((n_flip + 1))
+    local t0 t1 frc ftime fst fval fident fb vrc
+    t0=$EPOCHREALTIME
+    timeout "$TIMEOUT" "$TETCDT" -pQF --stats-json "$dir/flip.json" -o "$dir/flip" "$input" \
+        >"$dir/flip.out" 2>"$dir/flip.err"
+    frc=$?
+    t1=$EPOCHREALTIME
+    ftime="$(elapsed "$t0" "$t1")"
+    if [[ $frc != 0 ]]; then
+        FCOL="**failed** (exit $frc) / $ftime"
+        FLIP_PROBLEMS+=("$rel: \`tetcdt -pQF\` exit $frc: $(oneline <"$dir/flip.err")")
+        return 0
+    fi
+    sum_t_flip="$(awk -v a="$sum_t_flip" -v b="$ftime" 'BEGIN { printf "%.3f", a + b }')"
+    sum_t_cav="$(awk -v a="$sum_t_cav" -v b="$our_time" 'BEGIN { printf "%.3f", a + b }')"
+    if validator_reads "$name"; then
+        python3 "$VALIDATOR" "$input" "$dir/flip" >"$dir/validate_flip.out" 2>&1
+    else
+        "$TETCDT" -pQF --check -o "$dir/check_flip" "$input" >"$dir/validate_flip.out" 2>&1
+    fi
+    vrc=$?
+    if [[ $vrc == 0 ]]; then
+        fval=valid
+        n_flip_valid=$((n_flip_valid + 1))
+    else
+        fval="**INVALID**"
+        FLIP_PROBLEMS+=("$rel: \`tetcdt -pQF\` gives an invalid mesh: $(tail -n 1 "$dir/validate_flip.out" | oneline)")
+    fi
+    local fstats
+    fstats="$(python3 "$HELPER" "$input" "$dir/ours" "$dir/flip" 2>/dev/null)"
+    IFS=$'\x1f' read -r _ _ _ _ _ _ fst fident _ <<<"$fstats"
+    case "$fident" in
+        yes) n_flip_ident_cases=$((n_flip_ident_cases + 1)); n_flip_ident=$((n_flip_ident + 1)); fident="= -C" ;;
+        no) n_flip_ident_cases=$((n_flip_ident_cases + 1)); fident="**≠ -C**"
+            FLIP_PROBLEMS+=("$rel: -F and -C add no Steiner points but their tets differ") ;;
+        *) fident="n.a." ;;
+    esac
+    fb="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1])).get('flip_fallbacks', '?'))" "$dir/flip.json" 2>/dev/null)"
+    [[ "$fb" =~ ^[0-9]+$ ]] && n_flip_fallbacks=$((n_flip_fallbacks + fb))
+    FCOL="${fst:-?} / $fval / $fident / ${fb:-?} / $ftime"
+}
+
 # Sets distinct o_nodes o_tets o_st tg_nodes tg_tets tg_st ident note for the current
 # model, given our output prefix (or - for none); TetGen's figures from the tsv when it
 # was not run.
@@ -343,7 +400,7 @@ for rel in "${MODELS[@]}"; do
         UNSUPPORTED_LIST+=("$rel")
         model_stats -
         [[ $empty_expected == 1 ]] && tg_tets="0 (open surface)" tg_st="–"
-        ROWS+=("| $rel | unsupported format (.$ext) | – / ${tg_st:-?} | – / ${tg_tets:-?} | n.a. | – / $tg_time |")
+        ROWS+=("| $rel | unsupported format (.$ext) | – / ${tg_st:-?} | – / ${tg_tets:-?} | n.a. | – / $tg_time | – |")
         continue
     fi
     n_supported=$((n_supported + 1))
@@ -357,7 +414,7 @@ for rel in "${MODELS[@]}"; do
             valid="**NO**: exit $rc, expected 3 (TetGen's mesh is empty)"
             FAILURES+=("$rel: \`$cmd\` exited $rc, expected 3 (open surface: TetGen's mesh is empty). ${msg:+stderr: $msg}")
         fi
-        ROWS+=("| $rel | $valid | – / – | – / 0 | n.a. | $our_time / $tg_time |")
+        ROWS+=("| $rel | $valid | – / – | – / 0 | n.a. | $our_time / $tg_time | – |")
         continue
     fi
 
@@ -372,7 +429,8 @@ for rel in "${MODELS[@]}"; do
         esac
         FAILURES+=("$rel: \`$cmd\` $what. ${msg:+stderr: $msg}")
         model_stats -
-        ROWS+=("| $rel | **NO**: $what: ${msg:-no message} | – / ${tg_st:-?} | – / ${tg_tets:-?} | n.a. | $our_time / $tg_time |")
+        flip_column
+        ROWS+=("| $rel | **NO**: $what: ${msg:-no message} | – / ${tg_st:-?} | – / ${tg_tets:-?} | n.a. | $our_time / $tg_time | $FCOL |")
         continue
     fi
 
@@ -425,7 +483,8 @@ for rel in "${MODELS[@]}"; do
         n_both=$((n_both + 1))
     fi
     [[ -n "$tg_note" ]] && ident="$ident ($tg_note)"
-    ROWS+=("| $rel | $valid | ${o_st:-?} / ${tg_st:-?} | ${o_tets:-?} / ${tg_tets:-?} | $ident | $our_time / $tg_time |")
+    flip_column
+    ROWS+=("| $rel | $valid | ${o_st:-?} / ${tg_st:-?} | ${o_tets:-?} / ${tg_tets:-?} | $ident | $our_time / $tg_time | $FCOL |")
 done
 
 # ---------------------------------------------------------------------------------------
@@ -436,8 +495,8 @@ if [[ $HAVE_TETGEN == 0 ]]; then
 fi
 echo "## tetcdt -pQ on the corpus ($(date -u +%Y-%m-%d), $src)"
 echo
-echo "| model | ours valid? | Steiner (ours / TetGen) | tets (ours / TetGen) | identical to TetGen | time ours / TetGen (s) |"
-echo "|---|---|---|---|---|---|"
+echo "| model | ours valid? | Steiner (ours / TetGen) | tets (ours / TetGen) | identical to TetGen | time ours / TetGen (s) | -F: Steiner / valid / vs -C / fallbacks / time (s) |"
+echo "|---|---|---|---|---|---|---|"
 printf '%s\n' "${ROWS[@]}"
 echo
 echo "### Summary"
@@ -450,6 +509,9 @@ if [[ $n_both -gt 0 ]]; then
     echo "- time, total over $n_both models: ours **${sum_t_ours} s**, TetGen **${sum_t_tg} s**, ratio ours/TetGen **$ratio** (wall time, including reading and writing)"
 fi
 [[ ${#MORE_STEINER[@]} -gt 0 ]] && echo "- we add Steiner points where TetGen adds none: ${MORE_STEINER[*]}"
+if [[ $USE_FLIP == 1 ]]; then
+    echo "- -F (flips): valid **$n_flip_valid / $n_flip**; tets equal to -C where neither adds Steiner points **$n_flip_ident / $n_flip_ident_cases**; regions that fell back to cavities **$n_flip_fallbacks**; wall time over the models -F meshed: -F **${sum_t_flip} s**, -C **${sum_t_cav} s**"
+fi
 [[ ${#SKIPPED_NO_TSV[@]} -gt 0 ]] && echo "- not in tetgen_p_O0.tsv (TetGen cannot read them), skipped: ${SKIPPED_NO_TSV[*]}"
 [[ $ALL == 0 && ${#PATTERNS[@]} == 0 ]] && echo "- tetgen_stp/ skipped (use --all)"
 if [[ ${#FAILURES[@]} -gt 0 ]]; then
@@ -457,6 +519,12 @@ if [[ ${#FAILURES[@]} -gt 0 ]]; then
     echo "### Failures (${#FAILURES[@]})"
     echo
     printf -- '- %s\n' "${FAILURES[@]}"
+fi
+if [[ ${#FLIP_PROBLEMS[@]} -gt 0 ]]; then
+    echo
+    echo "### -F problems (${#FLIP_PROBLEMS[@]})"
+    echo
+    printf -- '- %s\n' "${FLIP_PROBLEMS[@]}"
 fi
 if [[ ${#DIFFERENCES[@]} -gt 0 ]]; then
     echo

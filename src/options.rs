@@ -430,12 +430,6 @@ impl Options {
                 },
             );
         }
-        if seen.flip {
-            seen.problems.push(SwitchProblem::Unimplemented {
-                switch: "F".into(),
-                what: "facet insertion by flips",
-            });
-        }
         if seen.cavity && seen.flip {
             seen.problems.push(SwitchProblem::Conflict('C', 'F'));
         }
@@ -645,10 +639,6 @@ mod tests {
         // (switches, substrings the message must contain)
         let table: &[(&[&str], &[&str])] = &[
             (
-                &["-pF"],
-                &["-F (facet insertion by flips) is not implemented yet"],
-            ),
-            (
                 &["-q"],
                 &["-q (quality mesh generation) is not implemented"],
             ),
@@ -761,14 +751,8 @@ mod tests {
             e.problems[..],
             [SwitchProblem::Needs { switch: 'C', .. }]
         ));
-        let e = Options::from_switches(["-pF"]).unwrap_err();
-        assert_eq!(
-            e.problems,
-            vec![SwitchProblem::Unimplemented {
-                switch: "F".into(),
-                what: "facet insertion by flips"
-            }]
-        );
+        let o = Options::from_switches(["-pF"]).unwrap();
+        assert_eq!(o.facet_algo, FacetAlgo::Flip);
         let o = Options::from_switches(["-pcAMS500"]).unwrap();
         assert!(o.plc && o.keep_hull && o.region_attributes && o.no_merge);
         assert_eq!(o.max_steiner, Some(500));
@@ -777,7 +761,7 @@ mod tests {
 
     #[test]
     fn facet_algo_selection() {
-        // -C/-F set the field (and -F is then refused as not implemented yet).
+        // -C/-F set the field.
         let mut o = Options::default();
         let _ = o.apply_switches(["-pF"]);
         assert!(o.plc);

@@ -78,12 +78,6 @@ fn run_points(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshe
 
 /// The `-p` pipeline: the constrained Delaunay tetrahedralization of the PLC, carved.
 fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
-    if opts.facet_algo == crate::options::FacetAlgo::Flip {
-        return Err(MeshError::Unsupported(
-            "facet insertion by flips (-F) is not implemented yet".into(),
-        )
-        .into());
-    }
     let start = Instant::now();
     let popts = crate::constrained::PlcOptions {
         merge: !opts.no_merge,
@@ -93,6 +87,10 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
         max_steiner: opts
             .max_steiner
             .unwrap_or((20 * plc.points.len()).max(1_000_000)),
+        inserter: match opts.facet_algo {
+            crate::options::FacetAlgo::Cavity => crate::constrained::FacetInserter::Cavity,
+            crate::options::FacetAlgo::Flip => crate::constrained::FacetInserter::Flip,
+        },
     };
     let mut warnings = crate::precheck::check(plc)?;
     let precheck_secs = start.elapsed().as_secs_f64();

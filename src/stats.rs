@@ -34,7 +34,7 @@ impl Stats {
         } else {
             0.0
         };
-        vec![
+        let mut rows = vec![
             ("(1) input vertices", p.input_points.to_string()),
             ("(2) input polygons", p.input_polygons.to_string()),
             ("(3) Steiner points", p.steiner_points.to_string()),
@@ -67,6 +67,57 @@ impl Stats {
                 "    restarts for Steiner points on polygons",
                 p.restarts.to_string(),
             ),
+        ];
+        if p.inserter == crate::constrained::FacetInserter::Flip {
+            let f = &p.flips;
+            let fallbacks = if p.flip_fallback_facets.is_empty() {
+                f.fallbacks.to_string()
+            } else {
+                let list: Vec<String> = p
+                    .flip_fallback_facets
+                    .iter()
+                    .map(|x| x.to_string())
+                    .collect();
+                format!("{} (merged facets {})", f.fallbacks, list.join(","))
+            };
+            rows.extend([
+                ("(8) flips performed", f.total().to_string()),
+                (
+                    "    2-3 / 3-2 / 4-4 flips",
+                    format!("{} / {} / {}", f.flips23, f.flips32, f.flips44),
+                ),
+                (
+                    "    repair flips (weights restored)",
+                    f.repair_flips.to_string(),
+                ),
+                (
+                    "    safeguard 1: refused, tet outside R",
+                    f.outside_r.to_string(),
+                ),
+                (
+                    "    safeguard 2: not locally regular, flipped",
+                    f.not_regular.to_string(),
+                ),
+                (
+                    "    safeguard 3: deferred to list L",
+                    f.deferred.to_string(),
+                ),
+                (
+                    "    flips refused by constraints",
+                    f.constrained.to_string(),
+                ),
+                (
+                    "    exact / perturbed flip-time comparisons",
+                    format!("{} / {}", f.exact_compares, f.perturbed_compares),
+                ),
+                ("    fallbacks to cavity retriangulation", fallbacks),
+                (
+                    "    hand-overs for polygons not flat",
+                    f.not_flat_handovers.to_string(),
+                ),
+            ]);
+        }
+        rows.extend([
             ("(12) Delaunay seconds", format!("{:.6}", p.delaunay_secs)),
             (
                 "(13) segment recovery seconds",
@@ -78,7 +129,8 @@ impl Stats {
             ),
             ("    carving seconds", format!("{:.6}", p.carve_secs)),
             ("(16) total CDT seconds", format!("{:.6}", self.total_secs)),
-        ]
+        ]);
+        rows
     }
 
     /// All figures as one JSON object (for `--stats-json`).
@@ -110,10 +162,36 @@ impl Stats {
                 ("segment_secs", json_f64(p.segment_secs)),
                 ("facet_secs", json_f64(p.facet_secs)),
                 ("carve_secs", json_f64(p.carve_secs)),
-                ("facet_algorithm", json_string("cavity")),
+                (
+                    "facet_algorithm",
+                    json_string(match p.inserter {
+                        crate::constrained::FacetInserter::Cavity => "cavity",
+                        crate::constrained::FacetInserter::Flip => "flip",
+                    }),
+                ),
                 ("plc", "true".into()),
             ];
             fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
+            let f = &p.flips;
+            let flips: [(&str, usize); 12] = [
+                ("flips", f.total()),
+                ("flips_2_3", f.flips23),
+                ("flips_3_2", f.flips32),
+                ("flips_4_4", f.flips44),
+                ("repair_flips", f.repair_flips),
+                ("safeguard_outside_r", f.outside_r),
+                ("safeguard_not_regular", f.not_regular),
+                ("safeguard_deferred", f.deferred),
+                ("flips_refused_by_constraints", f.constrained),
+                ("exact_flip_time_compares", f.exact_compares),
+                ("flip_fallbacks", f.fallbacks),
+                ("flip_not_flat_handovers", f.not_flat_handovers),
+            ];
+            fields.extend(
+                flips
+                    .into_iter()
+                    .map(|(k, v)| (k.to_string(), v.to_string())),
+            );
         }
         let body: Vec<String> = fields
             .iter()

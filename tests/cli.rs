@@ -60,10 +60,6 @@ fn usage_errors_exit_2_naming_the_switch() {
     write_points(&dir.path().join("p.node"), 8, 1);
     let table: &[(&[&str], &str)] = &[
         (
-            &["-pF", "p.node"],
-            "switch -F (facet insertion by flips) is not implemented yet",
-        ),
-        (
             &["-c", "p.node"],
             "switch -c (convex hull retention) needs -p",
         ),

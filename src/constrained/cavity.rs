@@ -293,15 +293,16 @@ fn adopt(cdt: &mut Cdt, region: &Region, normal: [f64; 3]) -> Option<Vec<[Vertex
 }
 
 /// The region's triangles, vertices and boundary edges.
-struct Region {
-    tris: Vec<[VertexId; 3]>,
-    verts: FxHashSet<VertexId>,
+pub(crate) struct Region {
+    pub(crate) tris: Vec<[VertexId; 3]>,
+    pub(crate) verts: FxHashSet<VertexId>,
     boundary: FxHashSet<(VertexId, VertexId)>,
     boxes: Vec<[[f64; 3]; 2]>,
 }
 
 impl Region {
-    fn new(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Self {
+    /// The region of triangles `tris`.
+    pub(crate) fn new(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Self {
         let mut count: FxHashMap<(VertexId, VertexId), u32> = FxHashMap::default();
         let mut verts = FxHashSet::default();
         for t in tris {
@@ -380,7 +381,7 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
 
 /// The tets whose interiors meet the region: those with an edge crossing it. They are
 /// face-connected, and each touches the region near a region vertex or is reached from one.
-fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
+pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
     let mut seen: FxHashSet<TetId> = FxHashSet::default();
     let mut out = Vec::new();
     let mut star = Vec::new();
@@ -783,7 +784,12 @@ fn largest_centroid(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Point {
 /// its circumcenter, brought onto the polygon's plane through `f`'s centroid (so it lies
 /// no farther from the polygon than its vertices do), if that lands in one of the
 /// region's triangles; else the centroid of the region's largest triangle.
-fn steiner_point(cdt: &Cdt, tris: &[[VertexId; 3]], f: [VertexId; 3], normal: [f64; 3]) -> Point {
+pub(crate) fn steiner_point(
+    cdt: &Cdt,
+    tris: &[[VertexId; 3]],
+    f: [VertexId; 3],
+    normal: [f64; 3],
+) -> Point {
     let p = |v: VertexId| cdt.dt.points[v as usize];
     let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
     let centroid: Point = std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0);

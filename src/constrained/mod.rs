@@ -10,6 +10,7 @@ pub mod cavity;
 pub mod cdt;
 pub mod enclosure;
 pub mod facet2d;
+pub mod flip;
 pub mod prepare;
 pub mod segments;
 
@@ -38,6 +39,36 @@ pub struct PlcOptions {
     pub region_attributes: bool,
     /// The most Steiner points to add (`-S`).
     pub max_steiner: usize,
+    /// How missing regions are inserted (`-C` / `-F`).
+    pub inserter: FacetInserter,
+}
+
+/// The facet insertion algorithm: both insert one missing region at a time, with the
+/// same contract (see [`cavity::insert_region`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FacetInserter {
+    /// Cavity retriangulation (paper §3.1, `-C`).
+    #[default]
+    Cavity,
+    /// Bistellar flips with exact flip-time ordering (paper §3.2, `-F`).
+    Flip,
+}
+
+impl FacetInserter {
+    /// Inserts the region `tris` of facet `facet` (flips add their figures to `flips`).
+    pub fn insert(
+        self,
+        cdt: &mut Cdt,
+        tris: &[[VertexId; 3]],
+        facet: u32,
+        normal: [f64; 3],
+        flips: &mut flip::FlipCounts,
+    ) -> Result<Outcome, MeshError> {
+        match self {
+            FacetInserter::Cavity => insert_region(cdt, tris, facet, normal),
+            FacetInserter::Flip => flip::insert_region(cdt, tris, facet, normal, flips),
+        }
+    }
 }
 
 impl Default for PlcOptions {
@@ -47,6 +78,7 @@ impl Default for PlcOptions {
             keep_hull: false,
             region_attributes: false,
             max_steiner: 10_000_000,
+            inserter: FacetInserter::Cavity,
         }
     }
 }
@@ -88,6 +120,12 @@ pub struct PlcStats {
     pub facet_secs: f64,
     /// Seconds for carving.
     pub carve_secs: f64,
+    /// The facet insertion algorithm used.
+    pub inserter: FacetInserter,
+    /// Flip insertion's figures (`-F`).
+    pub flips: flip::FlipCounts,
+    /// Facets whose regions fell back from flips to cavity retriangulation.
+    pub flip_fallback_facets: Vec<u32>,
 }
 
 /// The finished PLC mesh, its figures, and warnings for the user.
@@ -135,7 +173,11 @@ pub fn mesh_plc_with_progress(
     let mut prep = prepare(plc, opts.merge)?;
     // The message lists the boundary edges in the input's own terms.
     if !opts.keep_hull && enclosure::open_boundary(plc, &prep).is_some() {
-        return Err(MeshError::InvalidPlc(crate::precheck::empty_domain_message(plc)).into());
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::empty_domain_message(plc),
+        }
+        .into());
     }
     // Input facets kept out of merging because their merged group could not be
     // triangulated in one plane.
@@ -152,6 +194,7 @@ pub fn mesh_plc_with_progress(
         ));
     }
     let mut stats = PlcStats {
+        inserter: opts.inserter,
         input_points: plc.points.len(),
         input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
         ..Default::default()
@@ -412,7 +455,14 @@ fn attempt(
             }
         }
         for region in regions_of(&missing, &seg_markers) {
-            match insert_region(&mut cdt, &region, fi as u32, f.normal)? {
+            let fallbacks = stats.flips.fallbacks;
+            let outcome =
+                opts.inserter
+                    .insert(&mut cdt, &region, fi as u32, f.normal, &mut stats.flips)?;
+            if stats.flips.fallbacks > fallbacks {
+                stats.flip_fallback_facets.push(fi as u32);
+            }
+            match outcome {
                 Outcome::Inserted(rs) => {
                     stats.regions += 1;
                     stats.recovered_subfaces += rs.subfaces;

@@ -1,6 +1,8 @@
 //! Geometry: exact predicates with symbolic perturbation, and the Hilbert/BRIO ordering.
 
+pub mod expansion;
 pub mod hilbert;
+pub mod lifted;
 pub mod predicates;
 
 pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign, StaticFilter};

@@ -1,0 +1,1034 @@
+//! Facet insertion by bistellar flips (Shewchuk's flip algorithm; the paper's §3.2).
+//!
+//! The tets crossing a missing region R are flipped until no crossing triangle is left.
+//! Left vertices (one side of the polygon's plane) are lifted at a rate proportional to
+//! their height `Orient3D(a, b, c, v)`, so the tets in R stay a weighted CDT as time τ
+//! grows; each crossing triangle is certified with the time at which its two tets become
+//! cohyperplanar (Equation 1), and the earliest flip is done first. Flip times are
+//! compared exactly, ties broken by TetGen's symbolic perturbation (`geom::lifted`), so
+//! flips come off the queue in the right order.
+//!
+//! The paper's three safeguards are kept (and counted): a flip that would remove a tet
+//! outside R is refused; non-crossing faces next to new non-crossing tets are checked for
+//! local regularity and flipped if needed; a flip that cannot be done yet waits in a list
+//! L and is retried after every flip. If the region is still missing when the queue runs
+//! dry, the region falls back to cavity retriangulation, which is counted and reported.
+//!
+//! After the region is in, the weights are restored: faces in R that are not locally
+//! Delaunay (polygons that are not exactly flat) are repaired by flips where possible,
+//! and otherwise the region asks for a Steiner point on the polygon, like the cavity
+//! algorithm does.
+
+use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
+use super::cdt::{edge_key, face_key, Cdt};
+use crate::error::MeshError;
+use crate::geom::lifted::{
+    cross_sign, key_cross, Approx, CompareCounts, FlipTime, Lifting, TimeKey,
+};
+use crate::geom::{insphere_sos, orient3d, Point, Sign};
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
+use rustc_hash::FxHashSet;
+
+/// Figures of flip insertion, summed over regions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FlipCounts {
+    /// 2-3 flips.
+    pub flips23: usize,
+    /// 3-2 flips.
+    pub flips32: usize,
+    /// 4-4 flips.
+    pub flips44: usize,
+    /// Flips that restored local Delaunayhood after the weights were restored.
+    pub repair_flips: usize,
+    /// Safeguard 1: flips refused because they would remove a tet outside R.
+    pub outside_r: usize,
+    /// Safeguard 2: non-crossing faces found not locally regular, and flipped.
+    pub not_regular: usize,
+    /// Safeguard 3: flips that could not be done when dequeued and went to list L.
+    pub deferred: usize,
+    /// Flips refused because they would remove a subsegment or a triangle of the region.
+    pub constrained: usize,
+    /// Regions that fell back to cavity retriangulation.
+    pub fallbacks: usize,
+    /// Regions of polygons that are not flat, left without crossing simplices but not
+    /// recovered (near-shims, another triangulation of the polygon): handed to the
+    /// cavity code, which adopts the triangulation or places a Steiner point.
+    pub not_flat_handovers: usize,
+    /// Flip-time comparisons that needed exact arithmetic.
+    pub exact_compares: usize,
+    /// Of those, exact ties broken by the symbolic perturbation.
+    pub perturbed_compares: usize,
+}
+
+impl FlipCounts {
+    /// Adds `o` to these counts.
+    pub fn add(&mut self, o: &FlipCounts) {
+        self.flips23 += o.flips23;
+        self.flips32 += o.flips32;
+        self.flips44 += o.flips44;
+        self.repair_flips += o.repair_flips;
+        self.outside_r += o.outside_r;
+        self.not_regular += o.not_regular;
+        self.deferred += o.deferred;
+        self.constrained += o.constrained;
+        self.fallbacks += o.fallbacks;
+        self.not_flat_handovers += o.not_flat_handovers;
+        self.exact_compares += o.exact_compares;
+        self.perturbed_compares += o.perturbed_compares;
+    }
+
+    /// All flips done.
+    pub fn total(&self) -> usize {
+        self.flips23 + self.flips32 + self.flips44
+    }
+}
+
+/// Why a flip was not done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Refusal {
+    /// It would remove a tet outside R (safeguard 1).
+    OutsideR,
+    /// It would remove a subsegment or a triangle of the region.
+    Constrained,
+    /// The tets around the face do not allow a 2-3, 3-2 or 4-4 flip now.
+    NotFlippable,
+}
+
+/// A certified face: its flip time and the two tets it was certified for.
+struct Event {
+    time: FlipTime,
+    face: FaceRef,
+    t1: [VertexId; 4],
+    t2: [VertexId; 4],
+}
+
+/// Inserts the region `tris` of facet `facet` by flips; same contract as
+/// [`cavity::insert_region`]. Adds this region's figures to `total`, whatever the outcome.
+pub fn insert_region(
+    cdt: &mut Cdt,
+    tris: &[[VertexId; 3]],
+    facet: u32,
+    normal: [f64; 3],
+    total: &mut FlipCounts,
+) -> Result<Outcome, MeshError> {
+    let region = Region::new(cdt, tris);
+    let crossing = crossing_tets(cdt, &region);
+    if crossing.is_empty() {
+        // Nothing to flip: the cavity code adopts the mesh's own faces or asks for a point.
+        return cavity::insert_region(cdt, tris, facet, normal);
+    }
+    let lift = Lifting {
+        abc: largest_triangle(cdt, &region),
+    };
+    let mut fl = Flipper::new(cdt, &region, lift, &crossing);
+    let done = fl.run()?;
+    let problem = if done {
+        fl.repair()?
+    } else {
+        Some(Problem::Stuck)
+    };
+    // Taken after the repair, whose flips count and may destroy subfaces too.
+    let counts = total;
+    let mut here = fl.counts;
+    here.exact_compares = fl.cmp.exact;
+    here.perturbed_compares = fl.cmp.perturbed;
+    counts.add(&here);
+    let mut at_risk = std::mem::take(&mut fl.at_risk);
+    let crossing_left = fl.crossing_left;
+    drop(fl);
+    if debug() {
+        eprintln!(
+            "facet {facet}: {} crossing tets, {} flips, problem {problem:?}",
+            crossing.len(),
+            counts.total()
+        );
+    }
+    let flat = region
+        .verts
+        .iter()
+        .all(|&v| lift.side(&cdt.dt.points[v as usize]) == 0);
+    match problem {
+        None => {}
+        Some(Problem::Shim(f)) | Some(Problem::NotDelaunay(f)) if !flat => {
+            // The point goes on the polygon, at the region triangle nearest the trouble.
+            let near = tris
+                .iter()
+                .max_by_key(|t| t.iter().filter(|x| f.contains(x)).count())
+                .copied()
+                .unwrap_or(f);
+            return Ok(Outcome::NeedsSteiner(steiner_point(
+                cdt, tris, near, normal,
+            )));
+        }
+        Some(p) => {
+            // A polygon that is not flat, with no crossing simplex left, can still be
+            // crossed by tets whose vertices all lie on one side of the plane or on the
+            // polygon (near-shims), or be triangulated differently from its 2D CDT. The
+            // cavity code then adopts the mesh's triangulation or places a Steiner point:
+            // a hand-over for polygons that are not flat, not a failure of the flips.
+            let not_flat = matches!(p, Problem::Stuck) && !flat && crossing_left == 0;
+            if not_flat {
+                counts.not_flat_handovers += 1;
+            } else {
+                counts.fallbacks += 1;
+            }
+            if debug() {
+                eprintln!("facet {facet}: flips hand over to the cavity code ({p:?}, not flat {not_flat})");
+            }
+            let mut lost = lost_subfaces(cdt, &mut at_risk);
+            return Ok(match cavity::insert_region(cdt, tris, facet, normal)? {
+                Outcome::Inserted(mut rs) => {
+                    rs.lost.append(&mut lost);
+                    rs.lost.sort_unstable();
+                    rs.lost.dedup();
+                    Outcome::Inserted(rs)
+                }
+                other => other,
+            });
+        }
+    }
+    let lost = lost_subfaces(cdt, &mut at_risk);
+    for t in tris {
+        cdt.subfaces.insert(face_key(*t), facet);
+    }
+    Ok(Outcome::Inserted(RegionStats {
+        lost,
+        crossing_tets: crossing.len(),
+        enlarged_tets: 0,
+        subfaces: tris.len(),
+    }))
+}
+
+/// Whether to trace fallbacks on stderr (`TETCDT_DEBUG=1`).
+fn debug() -> bool {
+    std::env::var_os("TETCDT_DEBUG").is_some()
+}
+
+/// Removes the subfaces among `at_risk` that are no longer mesh faces; their facets.
+fn lost_subfaces(cdt: &mut Cdt, at_risk: &mut Vec<[VertexId; 3]>) -> Vec<u32> {
+    at_risk.sort_unstable();
+    at_risk.dedup();
+    let mut lost = Vec::new();
+    for key in at_risk.drain(..) {
+        if cdt.find_face(key[0], key[1], key[2]).is_none() {
+            if let Some(f) = cdt.subfaces.remove(&key) {
+                lost.push(f);
+            }
+        }
+    }
+    lost.sort_unstable();
+    lost.dedup();
+    lost
+}
+
+/// Three region vertices spanning approximately the largest triangle: the farthest
+/// vertex from the first, then the vertex farthest from their line.
+fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
+    verts.sort_unstable();
+    let a = p(verts[0]);
+    let d2 = |x: Point, y: Point| (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>();
+    let b = verts
+        .iter()
+        .map(|&v| p(v))
+        .max_by(|x, y| d2(*x, a).total_cmp(&d2(*y, a)))
+        .unwrap_or(a);
+    let area = |c: Point| {
+        let u: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
+        let w: [f64; 3] = std::array::from_fn(|k| c[k] - a[k]);
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+    };
+    let c = verts
+        .iter()
+        .map(|&v| p(v))
+        .max_by(|x, y| area(*x).total_cmp(&area(*y)))
+        .unwrap_or(a);
+    [a, b, c]
+}
+
+/// Scratch arrays indexed by vertex and tet id, valid where their stamp is the current
+/// one: per-region hash maps cost more than the flips themselves, and clearing arrays
+/// the size of the mesh for every region would cost more still.
+#[derive(Default)]
+struct Marks {
+    stamp: u32,
+    vert_stamp: Vec<u32>,
+    vert: Vec<(i8, Approx)>,
+    tet_stamp: Vec<u32>,
+}
+
+thread_local! {
+    static MARKS: std::cell::RefCell<Marks> = std::cell::RefCell::new(Marks::default());
+}
+
+impl Marks {
+    /// Starts a region: a fresh stamp, arrays large enough for the mesh.
+    fn next_stamp(&mut self, verts: usize, tets: usize) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.vert_stamp.iter_mut().for_each(|x| *x = 0);
+            self.tet_stamp.iter_mut().for_each(|x| *x = 0);
+            self.stamp = 1;
+        }
+        if self.vert_stamp.len() < verts {
+            self.vert_stamp.resize(verts, 0);
+            self.vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
+        }
+        if self.tet_stamp.len() < tets {
+            self.tet_stamp.resize(tets, 0);
+        }
+    }
+
+    #[inline]
+    fn side(&self, v: VertexId) -> Option<(i8, Approx)> {
+        (self.vert_stamp.get(v as usize) == Some(&self.stamp)).then(|| self.vert[v as usize])
+    }
+
+    fn set_side(&mut self, v: VertexId, side: i8, h: Approx) {
+        self.vert_stamp[v as usize] = self.stamp;
+        self.vert[v as usize] = (side, h);
+    }
+
+    #[inline]
+    fn has_tet(&self, t: TetId) -> bool {
+        self.tet_stamp.get(t as usize) == Some(&self.stamp)
+    }
+
+    fn add_tet(&mut self, t: TetId) {
+        if self.tet_stamp.len() <= t as usize {
+            self.tet_stamp.resize(t as usize + 1, 0);
+        }
+        self.tet_stamp[t as usize] = self.stamp;
+    }
+
+    fn remove_tet(&mut self, t: TetId) {
+        if let Some(x) = self.tet_stamp.get_mut(t as usize) {
+            *x = 0;
+        }
+    }
+}
+
+impl Drop for Flipper<'_> {
+    fn drop(&mut self) {
+        let marks = std::mem::take(&mut self.marks);
+        MARKS.with(|m| *m.borrow_mut() = marks);
+    }
+}
+
+/// What keeps a finished region from being a CDT.
+#[derive(Clone, Copy, Debug)]
+enum Problem {
+    /// The queue ran dry (or the flip budget ran out) with the region still missing.
+    Stuck,
+    /// A tet with four vertices on the polygon; one of its faces.
+    Shim([VertexId; 3]),
+    /// A face that is not locally Delaunay and no flip repairs.
+    NotDelaunay([VertexId; 3]),
+}
+
+/// The state of one region's flip insertion.
+struct Flipper<'a> {
+    cdt: &'a mut Cdt,
+    region: &'a Region,
+    lift: Lifting,
+    /// Per-vertex sides and heights, and the membership of tets in R (they change as
+    /// flips replace them), in arrays stamped for this region.
+    marks: Marks,
+    /// The tets put in R (some since flipped away: filter with `in_r`).
+    r_list: Vec<TetId>,
+    region_faces: FxHashSet<[VertexId; 3]>,
+    events: Vec<Event>,
+    /// Event slots free for reuse.
+    free_events: Vec<u32>,
+    /// The priority queue: events with their flip times' floating-point keys (most
+    /// comparisons are settled by the keys alone, without touching the events), and
+    /// whether the face was found not locally regular now (safeguard 2: flipped first).
+    heap: Vec<(TimeKey, u32, bool)>,
+    /// List L: dequeued flips that could not be done yet.
+    deferred: Vec<u32>,
+    /// The event being processed: the current time.
+    current: Option<u32>,
+    counts: FlipCounts,
+    cmp: CompareCounts,
+    /// Subfaces among the faces of deleted tets.
+    at_risk: Vec<[VertexId; 3]>,
+    /// Crossing tets (a left and a right vertex) left when the queue ran dry.
+    crossing_left: usize,
+}
+
+impl<'a> Flipper<'a> {
+    fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
+        let mut marks = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
+        marks.next_stamp(cdt.dt.points.len(), cdt.dt.mesh.num_slots());
+        for &t in crossing {
+            marks.add_tet(t);
+            for v in cdt.dt.mesh.verts(t) {
+                if marks.side(v).is_none() {
+                    let p = &cdt.dt.points[v as usize];
+                    let s = if region.verts.contains(&v) {
+                        0
+                    } else {
+                        lift.side(p) as i8
+                    };
+                    marks.set_side(v, s, lift.height_approx(p, s == 1));
+                }
+            }
+        }
+        Flipper {
+            cdt,
+            region,
+            lift,
+            marks,
+            r_list: crossing.to_vec(),
+            region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
+            events: Vec::new(),
+            free_events: Vec::new(),
+            heap: Vec::new(),
+            deferred: Vec::new(),
+            current: None,
+            counts: FlipCounts::default(),
+            cmp: CompareCounts::default(),
+            at_risk: Vec::new(),
+            crossing_left: 0,
+        }
+    }
+
+    /// Flips until no crossing triangle is left; true if the region's triangles are then
+    /// all mesh faces.
+    fn run(&mut self) -> Result<bool, MeshError> {
+        let mut r = self.tets_of_r();
+        r.sort_unstable();
+        for &t in &r {
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                let n = self.cdt.dt.mesh.adj(f).tet();
+                if t < n && self.in_r(n) {
+                    self.certify(f);
+                }
+            }
+        }
+        let budget = 50 * r.len() + 1000;
+        let mut flips = 0;
+        while let Some(e) = self.pop() {
+            if !self.valid(e) {
+                self.free_events.push(e);
+                continue;
+            }
+            flips += 1;
+            if flips > budget {
+                return Ok(false);
+            }
+            match self.try_flip(self.events[e as usize].face, false)? {
+                Ok(new) => {
+                    if let Some(old) = self.current.replace(e) {
+                        self.free_events.push(old);
+                    }
+                    self.after_flip(&new);
+                    self.retry_deferred()?;
+                }
+                Err(why) => {
+                    self.count_refusal(why);
+                    self.deferred.push(e);
+                    self.counts.deferred += 1;
+                }
+            }
+        }
+        let tris = self.region.tris.clone();
+        let ok = tris
+            .iter()
+            .all(|t| self.cdt.find_face(t[0], t[1], t[2]).is_some());
+        if !ok {
+            let r = self.tets_of_r();
+            self.crossing_left = r
+                .iter()
+                .filter(|&&t| self.is_crossing(&self.cdt.dt.mesh.verts(t)))
+                .count();
+            if debug() {
+                eprintln!(
+                    "stuck: {} tets in R, {} crossing, {} deferred flips",
+                    r.len(),
+                    self.crossing_left,
+                    self.deferred.len()
+                );
+            }
+        }
+        Ok(ok)
+    }
+
+    fn count_refusal(&mut self, why: Refusal) {
+        match why {
+            Refusal::OutsideR => self.counts.outside_r += 1,
+            Refusal::Constrained => self.counts.constrained += 1,
+            Refusal::NotFlippable => {}
+        }
+    }
+
+    /// Retries the flips in list L until none succeeds; drops the stale ones.
+    fn retry_deferred(&mut self) -> Result<(), MeshError> {
+        loop {
+            let mut progress = false;
+            let list = std::mem::take(&mut self.deferred);
+            let mut keep = Vec::new();
+            for e in list {
+                if !self.valid(e) {
+                    self.free_events.push(e);
+                    continue;
+                }
+                match self.try_flip(self.events[e as usize].face, false)? {
+                    Ok(new) => {
+                        self.after_flip(&new);
+                        self.free_events.push(e);
+                        progress = true;
+                    }
+                    Err(_) => keep.push(e),
+                }
+            }
+            self.deferred.extend(keep);
+            if !progress || self.deferred.is_empty() {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Certifies the crossing faces of the new tets, and checks the non-crossing faces
+    /// between non-crossing tets for local regularity now (safeguard 2).
+    fn after_flip(&mut self, new: &[TetId]) {
+        for &t in new {
+            let crossing_tet = self.is_crossing(&self.cdt.dt.mesh.verts(t));
+            for i in 0..4 {
+                let f = FaceRef::new(t, i);
+                let g = self.cdt.dt.mesh.adj(f);
+                if !self.in_r(g.tet()) {
+                    continue;
+                }
+                let fv = self.cdt.dt.mesh.face_verts(t, i);
+                if self.is_crossing(&fv) {
+                    // A face between two new tets: certified once, from the lower id.
+                    if g.tet() > t || !new.contains(&g.tet()) {
+                        self.certify(f);
+                    }
+                    continue;
+                }
+                if crossing_tet || self.is_crossing(&self.cdt.dt.mesh.verts(g.tet())) {
+                    continue;
+                }
+                if self.region_faces.contains(&face_key(fv)) || self.cdt.is_subface(t, i) {
+                    continue;
+                }
+                let Some(cur) = self.current else { continue };
+                // On one closed side the lift is affine: regularity cannot change.
+                let apex = self.cdt.dt.mesh.verts(g.tet())[g.face()];
+                let tv = self.cdt.dt.mesh.verts(t);
+                if !self.is_crossing(&[tv[0], tv[1], tv[2], tv[3], apex]) {
+                    continue;
+                }
+                let time = self.flip_time(f);
+                let now = &self.events[cur as usize].time;
+                if cross_sign(now, &time, &self.lift, &mut self.cmp) > 0 {
+                    self.counts.not_regular += 1;
+                    self.push_event(f, time, true);
+                }
+            }
+        }
+    }
+
+    /// Is tet `t` in R?
+    #[inline]
+    fn in_r(&self, t: TetId) -> bool {
+        self.marks.has_tet(t)
+    }
+
+    /// The tets of R now, without repeats.
+    fn tets_of_r(&mut self) -> Vec<TetId> {
+        let mut r: Vec<TetId> = self
+            .r_list
+            .iter()
+            .copied()
+            .filter(|&t| self.in_r(t))
+            .collect();
+        r.sort_unstable();
+        r.dedup();
+        self.r_list = r.clone();
+        r
+    }
+
+    fn is_crossing(&self, verts: &[VertexId]) -> bool {
+        let mut l = false;
+        let mut r = false;
+        for v in verts {
+            match self.marks.side(*v) {
+                Some((1, _)) => l = true,
+                Some((-1, _)) => r = true,
+                _ => {}
+            }
+        }
+        l && r
+    }
+
+    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last),
+    /// if it ever flips.
+    fn flip_time_if_flips(&self, f: FaceRef) -> Option<FlipTime> {
+        let mesh = &self.cdt.dt.mesh;
+        let g = mesh.adj(f);
+        let s = mesh.face_verts(f.tet(), f.face());
+        let v = mesh.verts(f.tet())[f.face()];
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [s[0], s[1], s[2], v, w];
+        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        let zero = Approx { v: 0.0, p: 0.0 };
+        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
+        FlipTime::if_flips(&self.lift, pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+    }
+
+    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last).
+    fn flip_time(&self, f: FaceRef) -> FlipTime {
+        let mesh = &self.cdt.dt.mesh;
+        let g = mesh.adj(f);
+        let s = mesh.face_verts(f.tet(), f.face());
+        let v = mesh.verts(f.tet())[f.face()];
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [s[0], s[1], s[2], v, w];
+        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        let zero = Approx { v: 0.0, p: 0.0 };
+        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
+        FlipTime::new(pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+    }
+
+    /// Queues the flip of crossing face `f` if it ever happens.
+    fn certify(&mut self, f: FaceRef) {
+        if let Some(time) = self.flip_time_if_flips(f) {
+            self.push_event(f, time, false);
+        }
+    }
+
+    fn push_event(&mut self, f: FaceRef, time: FlipTime, forced: bool) {
+        let mesh = &self.cdt.dt.mesh;
+        let e = Event {
+            time,
+            face: f,
+            t1: mesh.verts(f.tet()),
+            t2: mesh.verts(mesh.adj(f).tet()),
+        };
+        let key = e.time.key();
+        let idx = match self.free_events.pop() {
+            Some(i) => {
+                self.events[i as usize] = e;
+                i
+            }
+            None => {
+                self.events.push(e);
+                (self.events.len() - 1) as u32
+            }
+        };
+        self.heap.push((key, idx, forced));
+        let mut k = self.heap.len() - 1;
+        while k > 0 {
+            let parent = (k - 1) / 2;
+            if self.earlier(self.heap[k], self.heap[parent]) {
+                self.heap.swap(k, parent);
+                k = parent;
+            } else {
+                break;
+            }
+        }
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        if self.heap.is_empty() {
+            return None;
+        }
+        let (_, top, _) = self.heap.swap_remove(0);
+        let n = self.heap.len();
+        let mut k = 0;
+        loop {
+            let (l, r) = (2 * k + 1, 2 * k + 2);
+            let mut m = k;
+            if l < n && self.earlier(self.heap[l], self.heap[m]) {
+                m = l;
+            }
+            if r < n && self.earlier(self.heap[r], self.heap[m]) {
+                m = r;
+            }
+            if m == k {
+                break;
+            }
+            self.heap.swap(k, m);
+            k = m;
+        }
+        Some(top)
+    }
+
+    /// Does heap entry `a` come strictly before heap entry `b`?
+    fn earlier(
+        &mut self,
+        (ka, a, fa): (TimeKey, u32, bool),
+        (kb, b, fb): (TimeKey, u32, bool),
+    ) -> bool {
+        if fa || fb {
+            return if fa == fb { a < b } else { fa };
+        }
+        if let Some(s) = key_cross(&ka, &kb) {
+            self.cmp.filtered += 1;
+            return s < 0;
+        }
+        let (ea, eb) = (&self.events[a as usize], &self.events[b as usize]);
+        match cross_sign(&ea.time, &eb.time, &self.lift, &mut self.cmp) {
+            0 => a < b,
+            s => s < 0,
+        }
+    }
+
+    /// Are the event's two tets still there, glued at its face?
+    fn valid(&self, e: u32) -> bool {
+        let ev = &self.events[e as usize];
+        let mesh = &self.cdt.dt.mesh;
+        let (t1, t2) = (ev.face.tet(), mesh.adj(ev.face).tet());
+        mesh.is_alive(t1)
+            && mesh.verts(t1) == ev.t1
+            && mesh.is_alive(t2)
+            && mesh.verts(t2) == ev.t2
+            && self.in_r(t1)
+            && self.in_r(t2)
+    }
+
+    /// Removes face `f` by a 2-3, 3-2 or 4-4 flip, if the tets around it allow one and
+    /// it keeps the constraints; returns the new tets. `repair` allows flips outside the
+    /// crossing set's logic (the weights are restored) but still only inside R.
+    fn try_flip(
+        &mut self,
+        f: FaceRef,
+        repair: bool,
+    ) -> Result<Result<Vec<TetId>, Refusal>, MeshError> {
+        let mesh = &self.cdt.dt.mesh;
+        let (t1, i) = (f.tet(), f.face());
+        let g = mesh.adj(f);
+        let t2 = g.tet();
+        let v = mesh.verts(t1)[i];
+        let w = mesh.verts(t2)[g.face()];
+        let s = mesh.face_verts(t1, i);
+        let base = [s[0], s[1], s[2], v];
+        let rep = |k: usize| {
+            let mut b = base;
+            b[k] = w;
+            b
+        };
+        let pts = &self.cdt.dt.points;
+        let orient = |t: &[VertexId; 4]| {
+            let p = t.map(|x| &pts[x as usize]);
+            orient3d(p[0], p[1], p[2], p[3])
+        };
+        let o: [f64; 3] = std::array::from_fn(|k| orient(&rep(k)));
+        let neg: Vec<usize> = (0..3).filter(|&k| o[k] < 0.0).collect();
+        let zero: Vec<usize> = (0..3).filter(|&k| o[k] == 0.0).collect();
+        // The face of t1 opposite s[k] (it holds the edge of s without s[k], and v).
+        let opposite = |t: TetId, x: VertexId| {
+            let tv = mesh.verts(t);
+            (0..4).find(|&j| tv[j] == x)
+        };
+        let (old, new, kind): (Vec<TetId>, Vec<[VertexId; 4]>, usize) =
+            if neg.is_empty() && zero.is_empty() {
+                if self.region_faces.contains(&face_key(s)) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                (vec![t1, t2], vec![rep(0), rep(1), rep(2)], 23)
+            } else if neg.len() == 1 && zero.is_empty() {
+                let k = neg[0];
+                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+                let Some(j) = opposite(t1, s[k]) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                let t3 = mesh.adj(FaceRef::new(t1, j)).tet();
+                if !mesh.verts(t3).contains(&w) {
+                    return Ok(Err(Refusal::NotFlippable));
+                }
+                if self.edge_is_constrained(e0, e1, &[s[k], v, w]) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                (
+                    vec![t1, t2, t3],
+                    vec![rep((k + 1) % 3), rep((k + 2) % 3)],
+                    32,
+                )
+            } else if zero.len() == 1 && neg.is_empty() {
+                let k = zero[0];
+                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+                let (Some(j1), Some(j2)) = (opposite(t1, s[k]), opposite(t2, s[k])) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                let t3 = mesh.adj(FaceRef::new(t1, j1)).tet();
+                let t4 = mesh.adj(FaceRef::new(t2, j2)).tet();
+                let t3v = mesh.verts(t3);
+                let t4v = mesh.verts(t4);
+                let Some(&u) = t3v.iter().find(|&&x| x != e0 && x != e1 && x != v) else {
+                    return Ok(Err(Refusal::NotFlippable));
+                };
+                if u == w || !t4v.contains(&u) || !t4v.contains(&w) {
+                    return Ok(Err(Refusal::NotFlippable));
+                }
+                if self.edge_is_constrained(e0, e1, &[s[k], v, w, u]) {
+                    return Ok(Err(Refusal::Constrained));
+                }
+                // On u's side: t3 with e0 (then e1) replaced by w.
+                let mut extra = Vec::new();
+                for e in [e0, e1] {
+                    let mut t = t3v;
+                    if let Some(p) = t.iter().position(|&x| x == e) {
+                        t[p] = w;
+                    }
+                    if orient(&t) <= 0.0 {
+                        return Ok(Err(Refusal::NotFlippable));
+                    }
+                    extra.push(t);
+                }
+                let mut new = vec![rep((k + 1) % 3), rep((k + 2) % 3)];
+                new.extend(extra);
+                (vec![t1, t2, t3, t4], new, 44)
+            } else {
+                return Ok(Err(Refusal::NotFlippable));
+            };
+        if old.iter().any(|&t| !self.in_r(t)) {
+            return Ok(Err(Refusal::OutsideR));
+        }
+        let made = self.replace(&old, &new)?;
+        if repair {
+            self.counts.repair_flips += 1;
+        } else {
+            match kind {
+                23 => self.counts.flips23 += 1,
+                32 => self.counts.flips32 += 1,
+                _ => self.counts.flips44 += 1,
+            }
+        }
+        Ok(Ok(made))
+    }
+
+    /// Would removing edge `e0e1` (with the faces it spans with `apices`) lose a
+    /// subsegment or a triangle of the region?
+    fn edge_is_constrained(&self, e0: VertexId, e1: VertexId, apices: &[VertexId]) -> bool {
+        self.cdt.subsegs.contains_key(&edge_key(e0, e1))
+            || apices
+                .iter()
+                .any(|&x| self.region_faces.contains(&face_key([e0, e1, x])))
+    }
+
+    /// Replaces tets `old` by the positively oriented tets `new` (which fill the same
+    /// volume), gluing them to each other and to the outside.
+    fn replace(&mut self, old: &[TetId], new: &[[VertexId; 4]]) -> Result<Vec<TetId>, MeshError> {
+        let mesh = &mut self.cdt.dt.mesh;
+        let mut outer: Vec<([VertexId; 3], FaceRef)> = Vec::with_capacity(8);
+        let check_subfaces = !self.cdt.subfaces.is_empty();
+        for &t in old {
+            for j in 0..4 {
+                let key = face_key(mesh.face_verts(t, j));
+                let n = mesh.adj(FaceRef::new(t, j));
+                if !old.contains(&n.tet()) {
+                    outer.push((key, n));
+                }
+                if check_subfaces && self.cdt.subfaces.contains_key(&key) {
+                    self.at_risk.push(key);
+                }
+            }
+        }
+        for &t in old {
+            mesh.kill_tet(t);
+            self.marks.remove_tet(t);
+        }
+        let mut made = Vec::with_capacity(new.len());
+        for &v in new {
+            let t = mesh
+                .add_tet(v)
+                .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
+            made.push(t);
+        }
+        let keys: Vec<[[VertexId; 3]; 4]> = new
+            .iter()
+            .map(|v| std::array::from_fn(|j| face_key(FACE_VERTS[j].map(|x| v[x]))))
+            .collect();
+        for a in 0..made.len() {
+            'faces: for j in 0..4 {
+                for b in 0..made.len() {
+                    if b == a {
+                        continue;
+                    }
+                    if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == keys[a][j]) {
+                        if b > a {
+                            mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
+                        }
+                        continue 'faces;
+                    }
+                }
+                let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == keys[a][j]) else {
+                    return Err(MeshError::Internal(format!(
+                        "a flip left face {:?} without a neighbour",
+                        keys[a][j]
+                    )));
+                };
+                mesh.glue(FaceRef::new(made[a], j), n);
+            }
+        }
+        for &t in &made {
+            for x in mesh.verts(t) {
+                mesh.set_vertex_tet(x, t);
+            }
+            self.marks.add_tet(t);
+            self.r_list.push(t);
+        }
+        Ok(made)
+    }
+
+    /// With the weights restored: flips the faces in R that are not locally Delaunay
+    /// where a flip keeping the region can, and reports a shim or a face that remains.
+    fn repair(&mut self) -> Result<Option<Problem>, MeshError> {
+        let mut work: Vec<FaceRef> = Vec::new();
+        let mut r = self.tets_of_r();
+        r.sort_unstable();
+        for &t in &r {
+            for i in 0..4 {
+                work.push(FaceRef::new(t, i));
+            }
+        }
+        let mut budget = 20 * r.len() + 100;
+        let mut stuck: Vec<FaceRef> = Vec::new();
+        while let Some(f) = work.pop() {
+            if !self.not_delaunay(f) {
+                continue;
+            }
+            if budget == 0 {
+                stuck.push(f);
+                continue;
+            }
+            budget -= 1;
+            match self.try_flip(f, true)? {
+                Ok(new) => {
+                    for t in new {
+                        for i in 0..4 {
+                            work.push(FaceRef::new(t, i));
+                        }
+                    }
+                }
+                Err(_) => stuck.push(f),
+            }
+        }
+        for f in stuck {
+            if self.not_delaunay(f) {
+                return Ok(Some(Problem::NotDelaunay(
+                    self.cdt.dt.mesh.face_verts(f.tet(), f.face()),
+                )));
+            }
+        }
+        let mut r = self.tets_of_r();
+        r.sort_unstable();
+        for t in r {
+            let v = self.cdt.dt.mesh.verts(t);
+            if v.iter().all(|x| self.region.verts.contains(x)) {
+                return Ok(Some(Problem::Shim([v[0], v[1], v[2]])));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Is face `f` (of a live tet of R, not a constraint, not on the hull) not locally
+    /// Delaunay?
+    fn not_delaunay(&mut self, f: FaceRef) -> bool {
+        let mesh = &self.cdt.dt.mesh;
+        let t = f.tet();
+        if !mesh.is_alive(t) || !self.in_r(t) {
+            return false;
+        }
+        let g = mesh.adj(f);
+        // Faces on R's boundary count too: flips there are refused (safeguard 1), so
+        // such a face becomes a problem for the region instead of passing silently.
+        if mesh.is_ghost(g.tet()) {
+            return false;
+        }
+        let s = mesh.face_verts(t, f.face());
+        if self.region_faces.contains(&face_key(s)) || self.cdt.is_subface(t, f.face()) {
+            return false;
+        }
+        let tv = mesh.verts(t);
+        let w = mesh.verts(g.tet())[g.face()];
+        let ids = [tv[0], tv[1], tv[2], tv[3], w];
+        let p = ids.map(|x| &self.cdt.dt.points[x as usize]);
+        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        insphere_sos(p, orig) == Sign::Positive
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::delaunay::Delaunay;
+
+    fn lcg(s: &mut u64) -> f64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*s >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Points near the plane z = 0 and a big triangle in it, as the Figure 9 experiment:
+    /// inserted by flips, the result is a valid arena, keeps every vertex, has the
+    /// triangle as a face, and every other face is locally Delaunay (a CDT).
+    #[test]
+    fn flips_insert_a_triangle_into_random_points() {
+        for seed in 0..6u64 {
+            let mut s = seed * 7919 + 1;
+            // Far enough out that its edges are hull edges (the driver recovers them).
+            let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
+            while pts.len() < 150 {
+                let z = 0.2 * lcg(&mut s) - 0.1;
+                if z != 0.0 {
+                    pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
+                }
+            }
+            let dt = Delaunay::build(&pts).unwrap().dt;
+            let inv = dt.internal_ids(pts.len());
+            let mut cdt = Cdt::new(dt);
+            let tri = [inv[0], inv[1], inv[2]];
+            for k in 0..3 {
+                assert!(cdt.has_edge(tri[k], tri[(k + 1) % 3]));
+            }
+            let mut counts = FlipCounts::default();
+            let out = insert_region(&mut cdt, &[tri], 0, [0.0, 0.0, 1.0], &mut counts).unwrap();
+            let Outcome::Inserted(rs) = out else {
+                panic!("seed {seed}: {out:?}");
+            };
+            assert_eq!(counts.fallbacks, 0, "seed {seed}");
+            assert!(counts.total() > 0 && rs.crossing_tets > 10, "seed {seed}");
+            cdt.dt.mesh.check_links().unwrap();
+            assert!(cdt.find_face(tri[0], tri[1], tri[2]).is_some());
+            let mut used = vec![false; pts.len()];
+            let key = face_key(tri);
+            for t in cdt.dt.mesh.real_tets().collect::<Vec<_>>() {
+                let v = cdt.dt.mesh.verts(t);
+                let p = v.map(|x| &cdt.dt.points[x as usize]);
+                assert!(orient3d(p[0], p[1], p[2], p[3]) > 0.0);
+                for &x in &v {
+                    used[x as usize] = true;
+                }
+                for i in 0..4 {
+                    let g = cdt.dt.mesh.adj(FaceRef::new(t, i));
+                    if cdt.dt.mesh.is_ghost(g.tet())
+                        || face_key(cdt.dt.mesh.face_verts(t, i)) == key
+                    {
+                        continue;
+                    }
+                    let w = cdt.dt.mesh.verts(g.tet())[g.face()];
+                    let ids = [v[0], v[1], v[2], v[3], w];
+                    let q = ids.map(|x| &cdt.dt.points[x as usize]);
+                    let o = ids.map(|x| cdt.dt.orig[x as usize]);
+                    assert_ne!(insphere_sos(q, o), Sign::Positive, "seed {seed}");
+                }
+            }
+            assert!(used.iter().all(|&u| u), "seed {seed}: a vertex was lost");
+        }
+    }
+}

@@ -1,0 +1,230 @@
+//! Facet insertion by flips (`-F`) against cavity retriangulation (`-C`) and TetGen.
+//!
+//! - On every model in `data/plc/`, `-F` gives a mesh that passes `--check`'s checker,
+//!   and, where neither algorithm adds Steiner points, has exactly `-C`'s tets and never
+//!   fell back to the cavity algorithm.
+//! - The paper's stuck configuration (`data/flip/prism_stuck.poly`: cospherical prism
+//!   corners and a vertex inside their sphere) is inserted by flips alone, through
+//!   perturbed ties, with `-C`'s tets.
+//! - The Figure 9 experiment (`data/flip/fig9_300.poly`, from `gen_fig9.py`): `-F` gives
+//!   TetGen's tets (`data/flip/ref/`, from `tetgen -pcO0`) by flips alone.
+//! - Where the shared referee `validate_mesh.py` and numpy are found, `-F`'s meshes of
+//!   `data/plc/` pass it too (otherwise that part says it is skipped).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use tetcdt::constrained::flip::FlipCounts;
+use tetcdt::{Meshed, Options};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The model files in `data/plc/`, sorted.
+fn plc_models() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("data/plc"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("off" | "poly" | "smesh" | "obj")
+            )
+        })
+        .collect();
+    v.sort();
+    assert!(v.len() >= 20, "the PLC models are missing");
+    v
+}
+
+/// Meshes `path` with the packed switches `sw`, and checks the result.
+fn mesh(path: &Path, sw: &str) -> Meshed {
+    let plc = tetcdt::io::read_plc(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let opts = Options::from_switches([sw]).unwrap();
+    let m = tetcdt::tetrahedralize(&plc, &opts)
+        .unwrap_or_else(|e| panic!("{} {sw}: {e}", path.display()));
+    if let Err(problems) = tetcdt::check::check_mesh(&plc, &m.mesh) {
+        panic!("{} {sw}: check failed: {problems:?}", path.display());
+    }
+    m
+}
+
+fn tets(m: &Meshed) -> BTreeSet<[u32; 4]> {
+    m.mesh
+        .tets
+        .iter()
+        .map(|t| {
+            let mut k = *t;
+            k.sort_unstable();
+            k
+        })
+        .collect()
+}
+
+fn flips(m: &Meshed) -> FlipCounts {
+    m.stats.plc.as_ref().unwrap().flips
+}
+
+fn steiner(m: &Meshed) -> usize {
+    m.stats.plc.as_ref().unwrap().steiner_points
+}
+
+#[test]
+fn flips_match_cavities_on_every_model() {
+    let mut compared = 0;
+    let mut flipped = 0;
+    for path in plc_models() {
+        let c = mesh(&path, "-pQC");
+        let f = mesh(&path, "-pQF");
+        let counts = flips(&f);
+        if counts.total() > 0 {
+            flipped += 1;
+        }
+        if steiner(&c) == 0 && steiner(&f) == 0 {
+            // Polygons flat enough for -C to need no Steiner point never get the flips
+            // stuck (the prisms that are far from flat may, and then hand over, counted).
+            assert_eq!(counts.fallbacks, 0, "{}: {counts:?}", path.display());
+            assert_eq!(tets(&c), tets(&f), "{}", path.display());
+            compared += 1;
+        }
+    }
+    assert!(compared >= 12, "only {compared} models compared");
+    assert!(flipped >= 4, "only {flipped} models needed flips");
+}
+
+#[test]
+fn stuck_prism_is_inserted_by_flips_alone() {
+    let path = root().join("data/flip/prism_stuck.poly");
+    let f = mesh(&path, "-pcQF");
+    let c = mesh(&path, "-pcQC");
+    let counts = flips(&f);
+    assert_eq!(counts.fallbacks, 0, "{counts:?}");
+    assert!(counts.total() > 0, "{counts:?}");
+    // The cospherical corners make flip times tie exactly: the perturbation decides.
+    assert!(counts.perturbed_compares > 0, "{counts:?}");
+    assert_eq!(steiner(&f), 0);
+    assert_eq!(tets(&c), tets(&f));
+}
+
+/// Reads the tets of a TetGen `.ele` file (numbered from 1), as 0-based sorted rows.
+fn read_ele(path: &Path) -> BTreeSet<[u32; 4]> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut rows = text
+        .lines()
+        .map(|l| l.split('#').next().unwrap().trim())
+        .filter(|l| !l.is_empty());
+    let n: usize = rows
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    rows.take(n)
+        .map(|l| {
+            let v: Vec<u32> = l
+                .split_whitespace()
+                .skip(1)
+                .take(4)
+                .map(|x| x.parse::<u32>().unwrap() - 1)
+                .collect();
+            let mut k = [v[0], v[1], v[2], v[3]];
+            k.sort_unstable();
+            k
+        })
+        .collect()
+}
+
+#[test]
+fn figure_9_rectangle_by_flips_equals_tetgen() {
+    let path = root().join("data/flip/fig9_300.poly");
+    let f = mesh(&path, "-pcQF");
+    let counts = flips(&f);
+    let p = f.stats.plc.as_ref().unwrap();
+    assert_eq!(counts.fallbacks, 0, "{counts:?}");
+    assert!(p.crossing_tets > 300, "{}", p.crossing_tets);
+    assert!(counts.total() > p.crossing_tets / 2, "{counts:?}");
+    assert_eq!(steiner(&f), 0);
+    // Without Steiner points both keep the input numbering.
+    let ours = tets(&f);
+    let theirs = read_ele(&root().join("data/flip/ref/fig9_300.1.ele"));
+    let differ = ours.symmetric_difference(&theirs).count();
+    assert_eq!(
+        differ,
+        0,
+        "{} of our {} tets differ from TetGen's {}",
+        differ,
+        ours.len(),
+        theirs.len()
+    );
+    // Every vertex is in the mesh (none lost inside the evacuated region).
+    let used: BTreeSet<u32> = ours.iter().flatten().copied().collect();
+    assert_eq!(used.len(), f.mesh.points.len());
+}
+
+/// Cavity retriangulation on the same input: it should give the same tets, but it
+/// currently drops the vertices whose whole star crosses the rectangle (they are not on
+/// the cavity's boundary, so the cavities' Delaunay tetrahedralizations never see them).
+#[test]
+#[ignore = "known bug of -C: vertices inside the evacuated region are lost"]
+fn figure_9_rectangle_by_cavities_equals_flips() {
+    let path = root().join("data/flip/fig9_300.poly");
+    let f = mesh(&path, "-pcQF");
+    let c = mesh(&path, "-pcQC");
+    assert_eq!(tets(&c), tets(&f));
+}
+
+/// The shared referee and a python3 with numpy, if both are found.
+fn validator() -> Option<PathBuf> {
+    let dirs = [
+        std::env::var("TETCDT_TOOLS").ok().map(PathBuf::from),
+        Some(root().join("../shared/tools")),
+    ];
+    let v = dirs
+        .into_iter()
+        .flatten()
+        .map(|d| d.join("validate_mesh.py"))
+        .find(|p| p.is_file())?;
+    let ok = std::process::Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    ok.then_some(v)
+}
+
+#[test]
+fn flip_meshes_pass_the_referee() {
+    let Some(referee) = validator() else {
+        eprintln!("validate_mesh.py or numpy not found: referee check skipped");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut models = plc_models();
+    models.push(root().join("data/flip/prism_stuck.poly"));
+    for path in models {
+        let hull = path.ends_with("prism_stuck.poly");
+        let prefix = dir.path().join("out");
+        let sw = if hull { "-pcQF" } else { "-pQF" };
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_tetcdt"))
+            .args([sw, "-o"])
+            .arg(&prefix)
+            .arg(&path)
+            .status()
+            .unwrap();
+        assert!(st.success(), "{}", path.display());
+        let mut cmd = std::process::Command::new("python3");
+        cmd.arg(&referee).arg(&path).arg(&prefix);
+        if hull {
+            cmd.arg("--hull");
+        }
+        let out = cmd.output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && text.contains("VALID"),
+            "{}: {text}",
+            path.display()
+        );
+    }
+}
