@@ -163,11 +163,10 @@ fn figure_9_rectangle_by_flips_equals_tetgen() {
     assert_eq!(used.len(), f.mesh.points.len());
 }
 
-/// Cavity retriangulation on the same input: it should give the same tets, but it
-/// currently drops the vertices whose whole star crosses the rectangle (they are not on
-/// the cavity's boundary, so the cavities' Delaunay tetrahedralizations never see them).
+/// Cavity retriangulation on the same input gives the same tets: the vertices whose
+/// whole star crosses the rectangle are inside the cavity, not on its boundary, and are
+/// triangulated again on their side.
 #[test]
-#[ignore = "known bug of -C: vertices inside the evacuated region are lost"]
 fn figure_9_rectangle_by_cavities_equals_flips() {
     let path = root().join("data/flip/fig9_300.poly");
     let f = mesh(&path, "-pcQF");

@@ -103,7 +103,8 @@ pub fn insert_region(
                 (&bottom, true)
             };
             let all = side_faces(faces, &region, lid_flip);
-            let sdt = delaunay_of(cdt, &all)?;
+            let inner = inner_vertices(cdt, &cavity, &top, &bottom, &region);
+            let sdt = delaunay_of(cdt, &all, &inner[side])?;
             let missing = sdt.missing(&all);
             if missing.is_empty() {
                 sides[side] = Some(sdt);
@@ -152,6 +153,17 @@ pub fn insert_region(
                 return Ok(Outcome::NeedsSteiner(steiner_point(cdt, tris, f, normal)));
             }
             new_tets.push(v);
+        }
+    }
+    // Every vertex of the deleted tets must be a vertex of the new ones.
+    let mut kept_verts: FxHashSet<VertexId> = new_tets.iter().flatten().copied().collect();
+    kept_verts.insert(GHOST);
+    for &t in &cavity {
+        if let Some(&x) = cdt.dt.mesh.verts(t).iter().find(|x| !kept_verts.contains(x)) {
+            return Err(MeshError::Internal(format!(
+                "facet {facet}: the cavity retriangulation would lose vertex {}",
+                cdt.dt.orig[x as usize]
+            )));
         }
     }
     // Subsegments inside the cavity must survive: the new tets have no constraints.
@@ -534,6 +546,52 @@ fn surface_neighbor(
     ))
 }
 
+/// The vertices inside the cavity (on none of its boundary faces), above and below the
+/// region: their whole star is deleted, so each side's triangulation must include its
+/// own. The side is the one of the region triangle nearest the vertex, which is sound
+/// for a region that is flat up to rounding.
+fn inner_vertices(
+    cdt: &Cdt,
+    cavity: &[TetId],
+    top: &[CavFace],
+    bottom: &[CavFace],
+    region: &Region,
+) -> [Vec<VertexId>; 2] {
+    let mut on_boundary: FxHashSet<VertexId> = region.verts.iter().copied().collect();
+    on_boundary.extend(top.iter().chain(bottom).flat_map(|f| f.verts));
+    on_boundary.insert(GHOST);
+    let mut inner: FxHashSet<VertexId> = FxHashSet::default();
+    for &t in cavity {
+        for x in cdt.dt.mesh.verts(t) {
+            if !on_boundary.contains(&x) {
+                inner.insert(x);
+            }
+        }
+    }
+    let mut sides: [Vec<VertexId>; 2] = [Vec::new(), Vec::new()];
+    let p = |i: VertexId| cdt.dt.points[i as usize];
+    for x in inner {
+        let q = p(x);
+        let dist = |t: &[VertexId; 3]| -> f64 {
+            (0..3)
+                .map(|k| {
+                    let c = (p(t[0])[k] + p(t[1])[k] + p(t[2])[k]) / 3.0;
+                    (c - q[k]) * (c - q[k])
+                })
+                .sum()
+        };
+        let Some(t) = region.tris.iter().min_by(|a, b| dist(a).total_cmp(&dist(b))) else {
+            continue;
+        };
+        let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &q);
+        sides[usize::from(o <= 0.0)].push(x);
+    }
+    for s in &mut sides {
+        s.sort_unstable();
+    }
+    sides
+}
+
 /// The faces bounding one side: its cavity faces, and the region's triangles oriented so
 /// that the side lies on their positive side.
 fn side_faces(faces: &[CavFace], region: &Region, flip: bool) -> Vec<CavFace> {
@@ -557,8 +615,9 @@ struct SideDt {
 
 /// The Delaunay tetrahedralization of the vertices of `faces`, numbered in global
 /// perturbation order so that its ties are broken exactly as in the mesh.
-fn delaunay_of(cdt: &Cdt, faces: &[CavFace]) -> Result<SideDt, MeshError> {
+fn delaunay_of(cdt: &Cdt, faces: &[CavFace], inner: &[VertexId]) -> Result<SideDt, MeshError> {
     let mut gv: Vec<VertexId> = faces.iter().flat_map(|f| f.verts).collect();
+    gv.extend_from_slice(inner);
     gv.sort_unstable_by_key(|&v| cdt.dt.orig[v as usize]);
     gv.dedup();
     let pts: Vec<Point> = gv.iter().map(|&v| cdt.dt.points[v as usize]).collect();
