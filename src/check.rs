@@ -128,6 +128,7 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
     check_boundary(mesh, &boundary, &mut pr);
     if mesh.plc_mode {
         check_constraints(plc, mesh, &subfaces, &boundary, &mut pr);
+        check_points_kept(plc, mesh, &mut pr);
     } else {
         check_vertices_used(plc, mesh, &mut pr);
     }
@@ -271,6 +272,54 @@ fn outside_mesh(mesh: &MeshOut, a: Point, b: Point) -> bool {
             orient3d(&w[0], &w[1], &w[2], &w[3]) * o >= 0.0
         })
     })
+}
+
+/// PLC meshes: an input point that is no mesh vertex must lie outside the mesh (carved
+/// away with the exterior or a hole), and never inside a tet.
+fn check_points_kept(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
+    let mut used = vec![false; mesh.points.len()];
+    for t in &mesh.tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let rep = representatives(plc);
+    let unused: Vec<u32> = (0..plc.points.len() as u32)
+        .filter(|&i| rep[i as usize] == i && !used.get(i as usize).copied().unwrap_or(false))
+        .collect();
+    if unused.is_empty() {
+        return;
+    }
+    let p = |v: u32| mesh.points[v as usize];
+    for t in &mesh.tets {
+        let (mut lo, mut hi) = (p(t[0]), p(t[0]));
+        for &v in &t[1..] {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p(v)[k]);
+                hi[k] = hi[k].max(p(v)[k]);
+            }
+        }
+        let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &p(t[3]));
+        for &x in &unused {
+            let q = plc.points[x as usize];
+            if (0..3).any(|k| q[k] < lo[k] || q[k] > hi[k]) {
+                continue;
+            }
+            let inside = (0..4).all(|i| {
+                let mut w = [p(t[0]), p(t[1]), p(t[2]), p(t[3])];
+                w[i] = q;
+                orient3d(&w[0], &w[1], &w[2], &w[3]) * o >= 0.0
+            });
+            if inside {
+                pr.push(format!(
+                    "input point {} lies in tet {:?} but is not a mesh vertex",
+                    x as usize + mesh.first_index,
+                    shift(t, mesh.first_index)
+                ));
+                return;
+            }
+        }
+    }
 }
 
 /// The lowest-indexed point with the same coordinates, for each point.
@@ -711,6 +760,45 @@ mod tests {
         m2.tets.retain(|t| !t.contains(&9));
         m2.neighbors.clear();
         assert!(check_mesh(&plc, &m2).is_err());
+    }
+
+    #[test]
+    fn a_plc_point_inside_the_mesh_must_be_a_vertex() {
+        let cube = |extra: bool| {
+            let mut plc = cube_with_center();
+            plc.points.truncate(8);
+            if extra {
+                plc.points.push([0.4, 0.45, 0.55]);
+            }
+            let quads = [
+                [0, 2, 3, 1],
+                [4, 5, 7, 6],
+                [0, 1, 5, 4],
+                [2, 6, 7, 3],
+                [0, 4, 6, 2],
+                [1, 3, 7, 5],
+            ];
+            plc.facets = quads
+                .iter()
+                .map(|q| crate::plc::Facet {
+                    polygons: vec![q.to_vec()],
+                    ..Default::default()
+                })
+                .collect();
+            plc
+        };
+        let opts = Options {
+            plc: true,
+            ..Default::default()
+        };
+        let full = cube(true);
+        let m = crate::tetrahedralize(&full, &opts).unwrap().mesh;
+        check_mesh(&full, &m).unwrap();
+        // The cube meshed without its inner point, checked against the model with it.
+        let mut lost = crate::tetrahedralize(&cube(false), &opts).unwrap().mesh;
+        lost.points.push(full.points[8]);
+        let e = check_mesh(&full, &lost).unwrap_err().join("\n");
+        assert!(e.contains("input point 8 lies in tet"), "{e}");
     }
 
     #[test]

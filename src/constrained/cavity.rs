@@ -89,10 +89,37 @@ pub fn insert_region(
     }
     let crossing = cavity.len();
     let mut in_cav: FxHashSet<TetId> = cavity.iter().copied().collect();
-    let Some((mut top, mut bottom)) = split_sides(cdt, &region, &in_cav)? else {
-        return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
-    };
     let mut enlarged = 0;
+    let mut bubbles = Vec::new();
+    let (mut top, mut bottom) = loop {
+        bubbles.clear();
+        if let Some(sides) = split_sides(cdt, &region, &in_cav, &mut bubbles)? {
+            break sides;
+        }
+        if bubbles.is_empty() {
+            return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
+        }
+        // Tets that cross nothing but are walled in by crossing tets: the sides are
+        // triangulated afresh around them, so they join the cavity.
+        let mut stack: Vec<TetId> = bubbles.iter().map(|&f| cdt.dt.mesh.adj(f).tet()).collect();
+        while let Some(t) = stack.pop() {
+            if in_cav.contains(&t) {
+                continue;
+            }
+            if cdt.is_ghost(t) {
+                return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
+            }
+            in_cav.insert(t);
+            cavity.push(t);
+            enlarged += 1;
+            for i in 0..4 {
+                let n = cdt.dt.mesh.adj(FaceRef::new(t, i)).tet();
+                if !in_cav.contains(&n) {
+                    stack.push(n);
+                }
+            }
+        }
+    };
     let mut sides: [Option<SideDt>; 2] = [None, None];
     #[allow(clippy::needless_range_loop)] // `side` also selects the face list and lid
     for side in 0..2 {
@@ -159,7 +186,13 @@ pub fn insert_region(
     let mut kept_verts: FxHashSet<VertexId> = new_tets.iter().flatten().copied().collect();
     kept_verts.insert(GHOST);
     for &t in &cavity {
-        if let Some(&x) = cdt.dt.mesh.verts(t).iter().find(|x| !kept_verts.contains(x)) {
+        if let Some(&x) = cdt
+            .dt
+            .mesh
+            .verts(t)
+            .iter()
+            .find(|x| !kept_verts.contains(x))
+        {
             return Err(MeshError::Internal(format!(
                 "facet {facet}: the cavity retriangulation would lose vertex {}",
                 cdt.dt.orig[x as usize]
@@ -428,6 +461,7 @@ fn split_sides(
     cdt: &Cdt,
     region: &Region,
     in_cav: &FxHashSet<TetId>,
+    bubbles: &mut Vec<FaceRef>,
 ) -> Result<Option<Sides>, MeshError> {
     let mesh = &cdt.dt.mesh;
     let mut faces: Vec<FaceRef> = Vec::new();
@@ -444,11 +478,15 @@ fn split_sides(
     }
     let mut comp = vec![usize::MAX; faces.len()];
     let mut ncomp = 0;
+    // Whether each component reaches the region's boundary: the two sides do; any
+    // other is a bubble around tets enclosed by the cavity.
+    let mut rim: Vec<bool> = Vec::new();
     for start in 0..faces.len() {
         if comp[start] != usize::MAX {
             continue;
         }
         comp[start] = ncomp;
+        rim.push(false);
         let mut stack = vec![start];
         while let Some(fi) = stack.pop() {
             let f = faces[fi];
@@ -456,6 +494,7 @@ fn split_sides(
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 if region.boundary.contains(&(a.min(b), a.max(b))) {
+                    rim[ncomp] = true;
                     continue;
                 }
                 let g = surface_neighbor(cdt, f, a, b, in_cav)?;
@@ -467,6 +506,16 @@ fn split_sides(
             }
         }
         ncomp += 1;
+    }
+    if ncomp > 2 && rim.iter().filter(|&&r| r).count() == 2 {
+        bubbles.extend(
+            faces
+                .iter()
+                .zip(&comp)
+                .filter(|(_, &c)| !rim[c])
+                .map(|(&f, _)| f),
+        );
+        return Ok(None);
     }
     if ncomp != 2 {
         // The region's boundary does not split the cavity: part of the (not exactly
@@ -580,7 +629,11 @@ fn inner_vertices(
                 })
                 .sum()
         };
-        let Some(t) = region.tris.iter().min_by(|a, b| dist(a).total_cmp(&dist(b))) else {
+        let Some(t) = region
+            .tris
+            .iter()
+            .min_by(|a, b| dist(a).total_cmp(&dist(b)))
+        else {
             continue;
         };
         let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &q);
