@@ -123,7 +123,71 @@ pub fn insphere(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
         // the determinant is alternating, so negating restores our convention.
         return -det;
     }
+    if let Some(sign) = insphere_small_integers(a, b, c_, d, e) {
+        return sign;
+    }
     -robust::insphere(c(a), c(b), c(c_), c(d), c(e))
+}
+
+/// The exact sign of [`insphere`] when the coordinate differences from `e` are exact and,
+/// scaled by one power of two, integers below 2^23: then the determinant fits in an
+/// `i128`. Cospherical points on grids (CAD parts) end up here instead of in the
+/// expansion arithmetic of the last adaptive stage, which costs a hundred times more.
+fn insphere_small_integers(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> Option<f64> {
+    let mut diff = [[0.0f64; 3]; 4];
+    for (row, p) in diff.iter_mut().zip([a, b, c_, d]) {
+        for k in 0..3 {
+            let x = p[k] - e[k];
+            // Exact iff the subtraction's roundoff (two-diff) is zero.
+            let bv = p[k] - x;
+            let av = x + bv;
+            if (p[k] - av) + (bv - e[k]) != 0.0 || !x.is_finite() {
+                return None;
+            }
+            row[k] = x;
+        }
+    }
+    // The lowest and highest set bits over all differences, as powers of two.
+    let (mut lo, mut hi) = (i32::MAX, i32::MIN);
+    for &x in diff.iter().flatten() {
+        if x == 0.0 {
+            continue;
+        }
+        let bits = x.to_bits();
+        let exp = ((bits >> 52) & 0x7ff) as i32;
+        if exp == 0 {
+            return None; // subnormal
+        }
+        let mant = (bits & ((1u64 << 52) - 1)) | (1u64 << 52);
+        lo = lo.min(exp - 1075 + mant.trailing_zeros() as i32);
+        hi = hi.max(exp - 1023);
+    }
+    if lo == i32::MAX {
+        return Some(0.0);
+    }
+    if hi - lo >= 23 {
+        return None;
+    }
+    let scale = 2f64.powi(-lo);
+    let n: [[i128; 3]; 4] =
+        std::array::from_fn(|i| std::array::from_fn(|k| (diff[i][k] * scale) as i128));
+    let [[aex, aey, aez], [bex, bey, bez], [cex, cey, cez], [dex, dey, dez]] = n;
+    let ab = aex * bey - bex * aey;
+    let bc = bex * cey - cex * bey;
+    let cd = cex * dey - dex * cey;
+    let da = dex * aey - aex * dey;
+    let ac = aex * cey - cex * aey;
+    let bd = bex * dey - dex * bey;
+    let abc = aez * bc - bez * ac + cez * ab;
+    let bcd = bez * cd - cez * bd + dez * bc;
+    let cda = cez * da + dez * ac + aez * cd;
+    let dab = dez * ab + aez * bd + bez * da;
+    let alift = aex * aex + aey * aey + aez * aez;
+    let blift = bex * bex + bey * bey + bez * bez;
+    let clift = cex * cex + cey * cey + cez * cez;
+    let dlift = dex * dex + dey * dey + dez * dez;
+    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
+    Some(-(det.signum() as f64))
 }
 
 /// Static error bounds for [`orient3d`] and [`insphere`] on points inside a fixed
@@ -266,6 +330,50 @@ pub(crate) fn perturbed_sign<T: Copy, const N: usize, const M: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_integer_insphere_agrees_with_the_adaptive_one() {
+        let mut seed = 11u64;
+        let mut next = |m: i64| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) as i64 % m) as f64
+        };
+        let c = |p: &Point| robust::Coord3D {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+        };
+        let mut zeros = 0;
+        for round in 0..20_000 {
+            // Small grids make many cospherical quintuples; a scale of 2^-k or 2^k and
+            // an offset keep the differences exact.
+            let span = if round % 2 == 0 { 3 } else { 1000 };
+            let scale = 2f64.powi(round % 7 - 3);
+            let off = 1024.0 * scale;
+            let p: [Point; 5] = std::array::from_fn(|_| [0; 3].map(|_| next(span) * scale + off));
+            let want = -robust::insphere(c(&p[0]), c(&p[1]), c(&p[2]), c(&p[3]), c(&p[4]));
+            let got =
+                insphere_small_integers(&p[0], &p[1], &p[2], &p[3], &p[4]).expect("small integers");
+            let sign = |x: f64| (x > 0.0) as i32 - (x < 0.0) as i32;
+            assert_eq!(sign(got), sign(want), "{p:?}");
+            zeros += (want == 0.0) as usize;
+        }
+        assert!(zeros > 1000, "{zeros} cospherical cases");
+        // Differences that are not small integers are left to the adaptive predicate.
+        let q = [
+            [0.1, 0.0, 0.0],
+            [0.0, 0.3, 0.0],
+            [0.0, 0.0, 0.7],
+            [1.0, 1.0, 1.0],
+            [0.0; 3],
+        ];
+        assert_eq!(
+            insphere_small_integers(&q[0], &q[1], &q[2], &q[3], &q[4]),
+            None
+        );
+    }
 
     const A: Point = [0.0, 0.0, 0.0];
     const B: Point = [1.0, 0.0, 0.0];
