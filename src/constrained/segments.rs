@@ -124,7 +124,7 @@ pub fn recover_segments(
             let hit = |v: VertexId| touched.get(v as usize).copied().unwrap_or(true);
             let untouched = !(hit(pc.u) && hit(pc.v));
             if (untouched && present.contains(&key(pc.u, pc.v)))
-                || dt.has_edge(pc.u, pc.v, &mut scratch)
+                || edge_between(dt, pc.u, pc.v, &mut scratch)
             {
                 done.push(pc);
                 continue;
@@ -241,7 +241,7 @@ impl Recovered {
                 if other < x && cavity.binary_search(&other).is_ok() {
                     continue;
                 }
-                if cavity.binary_search(&other).is_ok() && !dt.has_edge(pc.u, pc.v, scratch) {
+                if cavity.binary_search(&other).is_ok() && !edge_between(dt, pc.u, pc.v, scratch) {
                     self.pieces[i] = None;
                     queue.push(pc);
                 }
@@ -276,6 +276,17 @@ impl Recovered {
             }
         }
     }
+}
+
+/// True if `a`–`b` is a mesh edge, walking around the newer vertex: Steiner points have
+/// small stars, while input vertices of CAD models can have huge fans.
+fn edge_between(
+    dt: &Delaunay,
+    a: VertexId,
+    b: VertexId,
+    scratch: &mut Vec<crate::mesh::TetId>,
+) -> bool {
+    dt.has_edge(a.max(b), a.min(b), scratch)
 }
 
 /// Sorted key of an edge.
