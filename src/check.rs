@@ -8,7 +8,7 @@
 //! locally Delaunay under the symbolic perturbation.
 
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
-use crate::mesh::FACE_VERTS;
+use crate::mesh::{EDGE_VERTS, FACE_VERTS};
 use crate::output::MeshOut;
 use crate::plc::Plc;
 
@@ -180,10 +180,8 @@ fn check_constraints(
     let mut edges: FxHashSet<(u32, u32)> = FxHashSet::default();
     let mut faces: FxHashSet<[u32; 3]> = FxHashSet::default();
     for t in &mesh.tets {
-        for a in 0..4 {
-            for b in a + 1..4 {
-                edges.insert((t[a].min(t[b]), t[a].max(t[b])));
-            }
+        for (a, b) in EDGE_VERTS {
+            edges.insert((t[a].min(t[b]), t[a].max(t[b])));
         }
         for fv in FACE_VERTS {
             let mut k = [t[fv[0]], t[fv[1]], t[fv[2]]];
@@ -223,7 +221,7 @@ fn check_constraints(
         adj.entry(a).or_default().push(b);
         adj.entry(b).or_default().push(a);
     }
-    let rep = representatives(plc);
+    let rep = crate::precheck::representatives(&plc.points);
     let mut seen_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
     for (fi, facet) in plc.facets.iter().enumerate() {
         for poly in &facet.polygons {
@@ -263,14 +261,17 @@ fn check_constraints(
 /// True if the midpoint of `a`–`b` lies in no tet (closed) of the mesh.
 fn outside_mesh(mesh: &MeshOut, a: Point, b: Point) -> bool {
     let q: Point = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
-    let p = |v: u32| mesh.points[v as usize];
-    !mesh.tets.iter().any(|t| {
-        let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &p(t[3]));
-        (0..4).all(|i| {
-            let mut w = [p(t[0]), p(t[1]), p(t[2]), p(t[3])];
-            w[i] = q;
-            orient3d(&w[0], &w[1], &w[2], &w[3]) * o >= 0.0
-        })
+    !mesh.tets.iter().any(|t| in_tet(mesh, t, &q))
+}
+
+/// True if `q` lies in tet `t` (boundary included): exact orientations.
+fn in_tet(mesh: &MeshOut, t: &[u32; 4], q: &Point) -> bool {
+    let w = t.map(|v| mesh.points[v as usize]);
+    let o = orient3d(&w[0], &w[1], &w[2], &w[3]);
+    (0..4).all(|i| {
+        let mut x = w;
+        x[i] = *q;
+        orient3d(&x[0], &x[1], &x[2], &x[3]) * o >= 0.0
     })
 }
 
@@ -283,7 +284,7 @@ fn check_points_kept(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
             used[v as usize] = true;
         }
     }
-    let rep = representatives(plc);
+    let rep = crate::precheck::representatives(&plc.points);
     let unused: Vec<u32> = (0..plc.points.len() as u32)
         .filter(|&i| rep[i as usize] == i && !used.get(i as usize).copied().unwrap_or(false))
         .collect();
@@ -299,18 +300,12 @@ fn check_points_kept(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
                 hi[k] = hi[k].max(p(v)[k]);
             }
         }
-        let o = orient3d(&p(t[0]), &p(t[1]), &p(t[2]), &p(t[3]));
         for &x in &unused {
             let q = plc.points[x as usize];
             if (0..3).any(|k| q[k] < lo[k] || q[k] > hi[k]) {
                 continue;
             }
-            let inside = (0..4).all(|i| {
-                let mut w = [p(t[0]), p(t[1]), p(t[2]), p(t[3])];
-                w[i] = q;
-                orient3d(&w[0], &w[1], &w[2], &w[3]) * o >= 0.0
-            });
-            if inside {
+            if in_tet(mesh, t, &q) {
                 pr.push(format!(
                     "input point {} lies in tet {:?} but is not a mesh vertex",
                     x as usize + mesh.first_index,
@@ -320,20 +315,6 @@ fn check_points_kept(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
             }
         }
     }
-}
-
-/// The lowest-indexed point with the same coordinates, for each point.
-fn representatives(plc: &Plc) -> Vec<u32> {
-    let mut order: Vec<u32> = (0..plc.points.len() as u32).collect();
-    let key = |i: u32| plc.points[i as usize].map(|c| (c + 0.0).to_bits());
-    order.sort_unstable_by_key(|&i| (key(i), i));
-    let mut rep: Vec<u32> = (0..plc.points.len() as u32).collect();
-    for w in 1..order.len() {
-        if key(order[w]) == key(order[w - 1]) {
-            rep[order[w] as usize] = rep[order[w - 1] as usize];
-        }
-    }
-    rep
 }
 
 /// Is edge `ab` used by a single polygon, or by polygons that are not coplanar? (Then it

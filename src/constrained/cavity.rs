@@ -15,7 +15,7 @@ use super::cdt::{face_key, Cdt};
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
 use crate::geom::{orient3d, Point};
-use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS, GHOST};
+use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS as EDGES, FACE_VERTS, GHOST};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Figures of one region insertion (rows of the paper's Table 1).
@@ -45,9 +45,6 @@ pub enum Outcome {
 
 /// The boundary faces of a cavity above and below its region.
 type Sides = (Vec<CavFace>, Vec<CavFace>);
-
-/// The 6 edges of a tet as pairs of slots.
-const EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// A face of the cavity boundary: the inward-oriented vertices and, for faces of the
 /// mesh, the tet inside the cavity and its face index.
@@ -701,13 +698,7 @@ fn delaunay_of(cdt: &Cdt, faces: &[CavFace], inner: &[VertexId]) -> Result<SideD
         .enumerate()
         .map(|(l, &g)| (g, l as VertexId))
         .collect();
-    let mut faces = FxHashMap::default();
-    for t in dt.mesh.real_tets() {
-        let v = dt.mesh.verts(t);
-        for (i, fv) in FACE_VERTS.iter().enumerate() {
-            faces.insert(face_key([v[fv[0]], v[fv[1]], v[fv[2]]]), FaceRef::new(t, i));
-        }
-    }
+    let faces = dt.mesh.face_index();
     Ok(SideDt {
         dt,
         global,
@@ -719,7 +710,7 @@ fn delaunay_of(cdt: &Cdt, faces: &[CavFace], inner: &[VertexId]) -> Result<SideD
 impl SideDt {
     /// The face `f` (mesh vertex ids) of this triangulation, seen from the tet on its
     /// positive side.
-    fn face(&self, f: [VertexId; 3], _star: &mut Vec<TetId>) -> Option<FaceRef> {
+    fn face(&self, f: [VertexId; 3]) -> Option<FaceRef> {
         let [a, b, c] = [
             self.local.get(&f[0])?,
             self.local.get(&f[1])?,
@@ -734,9 +725,8 @@ impl SideDt {
 
     /// Indices of the faces that are not faces of this triangulation.
     fn missing(&self, faces: &[CavFace]) -> Vec<usize> {
-        let mut star = Vec::new();
         (0..faces.len())
-            .filter(|&i| self.face(faces[i].verts, &mut star).is_none())
+            .filter(|&i| self.face(faces[i].verts).is_none())
             .collect()
     }
 
@@ -744,13 +734,12 @@ impl SideDt {
     /// positive side), as mesh vertex ids: a flood fill from the faces' inner tets that
     /// never crosses them.
     fn inside(&self, faces: &[CavFace]) -> Result<Vec<[VertexId; 4]>, MeshError> {
-        let mut star = Vec::new();
         let mut wall: FxHashSet<FaceRef> = FxHashSet::default();
         let mut stack = Vec::new();
         let mut inside: FxHashSet<TetId> = FxHashSet::default();
         for f in faces {
             let inner = self
-                .face(f.verts, &mut star)
+                .face(f.verts)
                 .ok_or_else(|| MeshError::Internal("a cavity face vanished".into()))?;
             wall.insert(inner);
             wall.insert(self.dt.mesh.adj(inner));

@@ -30,7 +30,7 @@ pub struct Cdt {
     pub subfaces: FxHashMap<[VertexId; 3], u32>,
     /// Faces of the mesh when [`Cdt::index_faces`] ran, each with a tet that had it: a
     /// hint that [`Cdt::has_face`] confirms in constant time while that tet is unchanged.
-    face_index: FxHashMap<[VertexId; 3], TetId>,
+    face_index: FxHashMap<[VertexId; 3], FaceRef>,
     scratch: Vec<TetId>,
 }
 
@@ -61,21 +61,13 @@ impl Cdt {
 
     /// Records every face of the mesh as it is now, for [`Cdt::has_face`].
     pub fn index_faces(&mut self) {
-        let mesh = &self.dt.mesh;
-        let mut index = FxHashMap::default();
-        index.reserve(2 * mesh.real_tets().count() + 16);
-        for t in mesh.real_tets() {
-            let v = mesh.verts(t);
-            for f in FACE_VERTS {
-                index.insert(face_key([v[f[0]], v[f[1]], v[f[2]]]), t);
-            }
-        }
-        self.face_index = index;
+        self.face_index = self.dt.mesh.face_index();
     }
 
     /// True if `(a, b, c)` is a face of the mesh.
     pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
-        if let Some(&t) = self.face_index.get(&face_key([a, b, c])) {
+        if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {
+            let t = f.tet();
             // The tet may have been deleted or reused since; if it still has the three
             // vertices, the face is there.
             let mesh = &self.dt.mesh;

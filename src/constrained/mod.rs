@@ -864,10 +864,8 @@ fn finish(
     // its edges then bound no tet and are not subsegments of the mesh.
     let mut mesh_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
     for t in &tets {
-        for a in 0..4 {
-            for b in a + 1..4 {
-                mesh_edges.insert((t[a].min(t[b]), t[a].max(t[b])));
-            }
+        for (a, b) in crate::mesh::EDGE_VERTS {
+            mesh_edges.insert(edge_key(t[a], t[b]));
         }
     }
     let mut warnings = Vec::new();

@@ -98,7 +98,7 @@ fn norm(n: [f64; 3]) -> f64 {
 
 /// Exact test: are all vertices of the ring on one line? (All three axis projections
 /// have zero orientation for every vertex against the first two distinct ones.)
-fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
+pub(crate) fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
     let p0 = points[ring[0] as usize];
     let Some(p1) = ring.iter().map(|&v| points[v as usize]).find(|p| *p != p0) else {
         return true;

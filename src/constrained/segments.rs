@@ -8,10 +8,11 @@
 //! is used. Steiner points are computed from the segment's original endpoints, so they
 //! lie on the segment up to rounding.
 
+use crate::constrained::cdt::edge_key;
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
 use crate::geom::Point;
-use crate::mesh::VertexId;
+use crate::mesh::{VertexId, EDGE_VERTS};
 
 /// The recovered segments.
 #[derive(Clone, Debug, Default)]
@@ -89,12 +90,12 @@ pub fn recover_segments(
     // around each would cost much more).
     let present: rustc_hash::FxHashSet<(VertexId, VertexId)> = {
         let wanted: rustc_hash::FxHashSet<(VertexId, VertexId)> =
-            queue.iter().map(|pc| key(pc.u, pc.v)).collect();
+            queue.iter().map(|pc| edge_key(pc.u, pc.v)).collect();
         let mut present = rustc_hash::FxHashSet::default();
         for t in dt.mesh.real_tets() {
             let v = dt.mesh.verts(t);
-            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-                let k = key(v[i], v[j]);
+            for (i, j) in EDGE_VERTS {
+                let k = edge_key(v[i], v[j]);
                 if wanted.contains(&k) {
                     present.insert(k);
                 }
@@ -123,7 +124,7 @@ pub fn recover_segments(
         while let Some(pc) = queue.pop() {
             let hit = |v: VertexId| touched.get(v as usize).copied().unwrap_or(true);
             let untouched = !(hit(pc.u) && hit(pc.v));
-            if (untouched && present.contains(&key(pc.u, pc.v)))
+            if (untouched && present.contains(&edge_key(pc.u, pc.v)))
                 || edge_between(dt, pc.u, pc.v, &mut scratch)
             {
                 done.push(pc);
@@ -256,12 +257,12 @@ impl Recovered {
             .pieces
             .iter()
             .flatten()
-            .map(|pc| key(pc.u, pc.v))
+            .map(|pc| edge_key(pc.u, pc.v))
             .collect();
         for t in dt.mesh.real_tets() {
             let v = dt.mesh.verts(t);
-            for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-                missing.remove(&key(v[i], v[j]));
+            for (i, j) in EDGE_VERTS {
+                missing.remove(&edge_key(v[i], v[j]));
             }
             if missing.is_empty() {
                 return;
@@ -269,7 +270,7 @@ impl Recovered {
         }
         for slot in &mut self.pieces {
             if let Some(pc) = *slot {
-                if missing.contains(&key(pc.u, pc.v)) {
+                if missing.contains(&edge_key(pc.u, pc.v)) {
                     *slot = None;
                     queue.push(pc);
                 }
@@ -287,11 +288,6 @@ fn edge_between(
     scratch: &mut Vec<crate::mesh::TetId>,
 ) -> bool {
     dt.has_edge(a.max(b), a.min(b), scratch)
-}
-
-/// Sorted key of an edge.
-fn key(a: VertexId, b: VertexId) -> (VertexId, VertexId) {
-    (a.min(b), a.max(b))
 }
 
 /// Vertices where two segments meet at less than 90 degrees.

@@ -171,23 +171,7 @@ fn insphere_small_integers(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Poin
     let scale = 2f64.powi(-lo);
     let n: [[i128; 3]; 4] =
         std::array::from_fn(|i| std::array::from_fn(|k| (diff[i][k] * scale) as i128));
-    let [[aex, aey, aez], [bex, bey, bez], [cex, cey, cez], [dex, dey, dez]] = n;
-    let ab = aex * bey - bex * aey;
-    let bc = bex * cey - cex * bey;
-    let cd = cex * dey - dex * cey;
-    let da = dex * aey - aex * dey;
-    let ac = aex * cey - cex * aey;
-    let bd = bex * dey - dex * bey;
-    let abc = aez * bc - bez * ac + cez * ab;
-    let bcd = bez * cd - cez * bd + dez * bc;
-    let cda = cez * da + dez * ac + aez * cd;
-    let dab = dez * ab + aez * bd + bez * da;
-    let alift = aex * aex + aey * aey + aez * aez;
-    let blift = bex * bex + bey * bey + bez * bez;
-    let clift = cex * cex + cey * cey + cez * cez;
-    let dlift = dex * dex + dey * dey + dez * dez;
-    let det = (dlift * abc - clift * dab) + (blift * cda - alift * bcd);
-    Some(-(det.signum() as f64))
+    Some(-(insphere_rows(n).signum() as f64))
 }
 
 /// Static error bounds for [`orient3d`] and [`insphere`] on points inside a fixed
@@ -253,6 +237,22 @@ fn insphere_det(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
     let (bex, bey, bez) = (b[0] - e[0], b[1] - e[1], b[2] - e[2]);
     let (cex, cey, cez) = (c_[0] - e[0], c_[1] - e[1], c_[2] - e[2]);
     let (dex, dey, dez) = (d[0] - e[0], d[1] - e[1], d[2] - e[2]);
+    insphere_rows([
+        [aex, aey, aez],
+        [bex, bey, bez],
+        [cex, cey, cez],
+        [dex, dey, dez],
+    ])
+}
+
+/// Shewchuk's insphere determinant of the rows `p - e` (one formula for `f64` and for
+/// the exact `i128` path).
+#[inline(always)]
+fn insphere_rows<T>(r: [[T; 3]; 4]) -> T
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T> + std::ops::Mul<Output = T>,
+{
+    let [[aex, aey, aez], [bex, bey, bez], [cex, cey, cez], [dex, dey, dez]] = r;
     let ab = aex * bey - bex * aey;
     let bc = bex * cey - cex * bey;
     let cd = cex * dey - dex * cey;

@@ -28,6 +28,9 @@ pub const MAX_TETS: usize = 1 << 30;
 /// permutation of `(0, 1, 2, 3)`: the face seen with `v[i]` on its positive side.
 pub const FACE_VERTS: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
 
+/// The 6 edges of a tet as pairs of vertex slots.
+pub const EDGE_VERTS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
 /// A reference to one face of one tet: `tet << 2 | face`.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct FaceRef(pub u32);
@@ -249,6 +252,21 @@ impl Mesh {
             .enumerate()
             .filter(|(_, t)| t.v[0] != DEAD && t.v[3] != GHOST)
             .map(|(i, _)| i as TetId)
+    }
+
+    /// Every face of the real tets, keyed by its sorted vertices, with one tet side of
+    /// it: constant-time face lookups for as long as the mesh does not change.
+    pub fn face_index(&self) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
+        let mut index = rustc_hash::FxHashMap::default();
+        for t in self.real_tets() {
+            let v = self.verts(t);
+            for (i, fv) in FACE_VERTS.iter().enumerate() {
+                let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
+                k.sort_unstable();
+                index.insert(k, FaceRef::new(t, i));
+            }
+        }
+        index
     }
 
     /// Checks that every link is symmetric and glues faces with the same vertex set in

@@ -275,7 +275,7 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
     for (fi, f) in plc.facets.iter().enumerate() {
         for (pi, poly) in f.polygons.iter().enumerate() {
             let ring = clean_ring(poly, &rep);
-            if ring.len() >= 3 && all_collinear(&plc.points, &ring) {
+            if ring.len() >= 3 && crate::constrained::prepare::all_collinear(&plc.points, &ring) {
                 return Err(invalid(
                     plc,
                     format!(
@@ -415,23 +415,6 @@ fn repeated(poly: &[u32]) -> Option<(usize, usize)> {
     poly.iter()
         .enumerate()
         .find_map(|(k, &v)| seen.insert(v, k).map(|j| (j, k)))
-}
-
-/// Exact test: are all vertices of the ring on one line? (Every axis projection has zero
-/// orientation for every vertex against the first two distinct ones.)
-fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
-    let p0 = points[ring[0] as usize];
-    let Some(p1) = ring.iter().map(|&v| points[v as usize]).find(|p| *p != p0) else {
-        return true;
-    };
-    ring.iter().all(|&v| {
-        let q = points[v as usize];
-        (0..3).all(|k| {
-            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-            let c = |p: [f64; 3]| robust::Coord { x: p[i], y: p[j] };
-            robust::orient2d(c(p0), c(p1), c(q)) == 0.0
-        })
-    })
 }
 
 /// Every pair of input facets that meet other than at shared vertices and edges, at the
