@@ -96,7 +96,7 @@ fn flood(cdt: &Cdt, stack: &mut Vec<TetId>, removed: &mut [bool]) {
 }
 
 /// The real tet containing point `p`, if it lies inside the hull.
-fn containing_tet(cdt: &mut Cdt, p: &Point) -> Option<TetId> {
+pub(crate) fn containing_tet(cdt: &mut Cdt, p: &Point) -> Option<TetId> {
     match cdt.dt.locate(p) {
         Location::Inside(t) => Some(t),
         Location::Vertex(v) => cdt.dt.mesh.vertex_tet(v).filter(|&t| !cdt.is_ghost(t)),

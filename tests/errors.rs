@@ -365,13 +365,13 @@ fn steiner_bound_exits_1_with_the_reason() {
     let out = Command::cargo_bin("tetcdt")
         .unwrap()
         .current_dir(dir.path())
-        .args(["-pQS5", "p.poly"])
+        .args(["-pQS1", "p.poly"])
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(
-        stderr.contains("need more than 5 Steiner points (the -S limit)"),
+        stderr.contains("need more than 1 Steiner points (the -S limit)"),
         "{stderr}"
     );
     assert_eq!(listing(dir.path()), ["p.poly", "s.off"]);

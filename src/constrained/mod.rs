@@ -13,6 +13,7 @@ pub mod facet2d;
 pub mod flip;
 pub mod prepare;
 pub mod segments;
+mod slivers;
 
 use crate::carve::carve;
 use crate::delaunay::Delaunay;
@@ -138,9 +139,6 @@ pub struct PlcMesh {
     pub warnings: Vec<String>,
 }
 
-/// An edge as a pair of vertex ids.
-type Edge = (VertexId, VertexId);
-
 /// Whether to trace restarts and Steiner points on stderr (`TETCDT_DEBUG=1`).
 fn debug() -> bool {
     std::env::var_os("TETCDT_DEBUG").is_some()
@@ -152,6 +150,10 @@ fn debug() -> bool {
 fn max_facet_points(plc: &Plc) -> usize {
     (4 * plc.points.len()).max(1000)
 }
+
+/// The facet of a Steiner point that lies on none: it removes a flat tet from the domain
+/// (see [`slivers`]).
+const FREE_POINT: usize = usize::MAX;
 
 /// Marks the failure to triangulate a merged group in one plane (then split).
 const UNFLAT_GROUP: &str = "merged facets ";
@@ -171,6 +173,13 @@ pub fn mesh_plc_with_progress(
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
     let mut prep = prepare(plc, opts.merge)?;
+    // Flat tets are judged on the facets as merged by default, whatever the switches and
+    // the splitting of groups below did.
+    let merged = if opts.merge {
+        prep.clone()
+    } else {
+        prepare(plc, true)?
+    };
     // The message lists the boundary edges in the input's own terms.
     if !opts.keep_hull && enclosure::open_boundary(plc, &prep).is_some() {
         return Err(crate::error::InputError::Invalid {
@@ -206,7 +215,7 @@ pub fn mesh_plc_with_progress(
     loop {
         let outcome = match attempt(
             plc,
-            &prep,
+            [&prep, &merged],
             &facet_points,
             &presplits,
             opts,
@@ -260,7 +269,8 @@ pub fn mesh_plc_with_progress(
                     .into());
                 }
                 if stats.restarts > MAX_RESTARTS
-                    || facet_points.len() + more.len() > max_facet_points(plc)
+                    || facet_points.len() + more.len() + presplits.len() + splits.len()
+                        > max_facet_points(plc)
                 {
                     return Err(MeshError::Failed(format!(
                         "polygons that are not flat still conflict after {} Steiner points on them",
@@ -280,10 +290,11 @@ enum Attempt {
     Restart(Vec<(usize, Point)>, Vec<(usize, f64)>),
 }
 
-/// One construction from scratch: Delaunay, segments, facets.
+/// One construction from scratch: Delaunay, segments, facets. `prep` is the PLC as
+/// meshed, `merged` with every coplanar group merged (for [`slivers`]).
 fn attempt(
     plc: &Plc,
-    prep: &PreparedPlc,
+    [prep, merged]: [&PreparedPlc; 2],
     facet_points: &[(usize, Point)],
     presplits: &[(usize, f64)],
     opts: &PlcOptions,
@@ -348,7 +359,7 @@ fn attempt(
     let mut extra: Vec<Vec<VertexId>> = vec![Vec::new(); prep.facets.len()];
     for (k, &(f, _)) in facet_points.iter().enumerate() {
         let v = inv[n_input + k];
-        if v != u32::MAX {
+        if v != u32::MAX && f != FREE_POINT {
             extra[f].push(v);
         }
     }
@@ -499,12 +510,19 @@ fn attempt(
     }
     stats.facet_secs = t2.elapsed().as_secs_f64();
     if steiner.is_empty() && splits.is_empty() {
-        let (more, edges) = resolve_shims(&mut cdt, plc, opts);
-        steiner.extend(more);
-        for (u, v) in edges {
-            let seg = seg_of[&edge_key(u, v)];
-            splits.push((seg, midpoint_parameter(&cdt, &subsegs.chains[seg], u, v)));
+        steiner.extend(resolve_shims(&mut cdt, plc, opts));
+    }
+    if steiner.is_empty() && splits.is_empty() {
+        let domain = slivers::Domain {
+            holes: &plc.holes,
+            regions: &plc.regions,
+            keep_hull: opts.keep_hull,
+        };
+        let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain);
+        if debug() && !free.is_empty() {
+            eprintln!("free points {free:?}");
         }
+        steiner.extend(free.into_iter().map(|p| (FREE_POINT, p)));
     }
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
@@ -627,7 +645,7 @@ fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -
 /// polygon's triangles instead puts it outside, where carving removes it. A shim that
 /// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
 /// are returned, and the construction starts again.
-fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Point)>, Vec<Edge>) {
+fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Point)> {
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
     {
         // A shim has four vertices on one facet: facets of three vertices have none.
@@ -642,11 +660,10 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Po
         }
     }
     let mut steiner = Vec::new();
-    let mut split_edges = Vec::new();
     if facet_verts.is_empty() {
-        return (steiner, split_edges);
+        return steiner;
     }
-    for _round in 0..8 {
+    for _round in 0..64 {
         let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
         let mut swapped = false;
@@ -682,18 +699,21 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Po
                 // at a subface does not help slivers outside the polygon, so leave them.
                 continue;
             }
-            // The two subfaces' shared edge disappears with the swap: if it is a
-            // subsegment, split it instead.
-            if sub.len() == 2 && !free.is_empty() {
-                let shared: Vec<VertexId> = sub[0]
-                    .iter()
-                    .copied()
-                    .filter(|x| sub[1].contains(x))
-                    .collect();
-                if shared.len() == 2 && cdt.subsegs.contains_key(&edge_key(shared[0], shared[1])) {
-                    split_edges.push((shared[0], shared[1]));
-                    continue;
-                }
+            // Edges between the subfaces disappear with the swap. If one is a
+            // subsegment, the shim stays: splitting the subsegment only makes smaller
+            // shims of the same shape (a step or dent at a segment), so a flat one is
+            // left to a free vertex (see `slivers`).
+            let lost_subsegment = crate::mesh::EDGE_VERTS.iter().any(|&(i, j)| {
+                let (a, b) = edge_key(v[i], v[j]);
+                let in_faces = |fs: &[[VertexId; 3]]| {
+                    fs.iter()
+                        .filter(|k| k.contains(&a) && k.contains(&b))
+                        .count()
+                };
+                in_faces(&sub) == 2 && in_faces(&free) == 0 && cdt.subsegs.contains_key(&(a, b))
+            });
+            if lost_subsegment {
+                continue;
             }
             if free.is_empty() || kept_behind_sub {
                 // Both sides of the polygon keep the shim: only a Steiner point helps.
@@ -710,17 +730,14 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> (Vec<(usize, Po
             }
             swapped = true;
         }
-        if !needs.is_empty() || !split_edges.is_empty() {
+        // Swaps can uncover shims stacked behind others: Steiner points are only for
+        // what no swap can remove.
+        if !swapped {
             steiner = needs;
             break;
         }
-        if !swapped {
-            break;
-        }
     }
-    split_edges.sort_unstable();
-    split_edges.dedup();
-    (steiner, split_edges)
+    steiner
 }
 
 /// Calls `f` on every edge of the facet's rings and inner segments.

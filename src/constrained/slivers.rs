@@ -1,0 +1,262 @@
+//! Flat tets whose four vertices all lie on one facet yet survive carving. They span a
+//! step or a dent of a facet that is not flat (a merged group of nearly coplanar
+//! polygons, or a thin wedge between two of them), where both sides agree on the
+//! polygon's triangles, so [`super::resolve_shims`] has nothing to swap. A Steiner point
+//! on the facet cannot help: whatever it forms with the facet's vertices is as flat. A
+//! free vertex inside the tet's circumsphere, well off the facet and inside the domain,
+//! removes the tet from the CDT instead.
+
+use super::cdt::Cdt;
+use super::prepare::PreparedPlc;
+use crate::carve::{carve, containing_tet};
+use crate::geom::predicates::{insphere, orient3d};
+use crate::geom::Point;
+use crate::plc::Region;
+use rustc_hash::FxHashSet;
+
+/// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
+/// referee's measure (1e-3) with a margin, so that what we remove is what it flags.
+const FLAT: f64 = 1.5e-3;
+
+/// A merged facet's plane, with the slab and box within which a Steiner point counts as
+/// lying on it (four times the facet's own deviation from flat).
+struct Slab {
+    normal: Point,
+    mean: Point,
+    tol: f64,
+    lo: Point,
+    hi: Point,
+}
+
+impl Slab {
+    fn height(&self, p: &Point) -> f64 {
+        (0..3).map(|k| (p[k] - self.mean[k]) * self.normal[k]).sum()
+    }
+
+    fn holds(&self, p: &Point) -> bool {
+        self.height(p).abs() <= self.tol
+            && (0..3).all(|k| p[k] >= self.lo[k] - self.tol && p[k] <= self.hi[k] + self.tol)
+    }
+}
+
+/// The domain that carving leaves, as [`carve`] needs it.
+pub(crate) struct Domain<'a> {
+    pub holes: &'a [Point],
+    pub regions: &'a [Region],
+    pub keep_hull: bool,
+}
+
+/// Free vertices that remove the flat tets lying on one facet, one per such tet: empty
+/// when there are none.
+pub(crate) fn free_points(
+    cdt: &mut Cdt,
+    prep: &PreparedPlc,
+    input: &[Point],
+    domain: &Domain<'_>,
+) -> Vec<Point> {
+    let n_input = input.len();
+    let diag = diagonal(input);
+    let mut facets_of: Vec<Vec<u32>> = vec![Vec::new(); n_input];
+    let mut slabs: Vec<Option<Slab>> = Vec::with_capacity(prep.facets.len());
+    for (fi, f) in prep.facets.iter().enumerate() {
+        let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
+        verts.sort_unstable();
+        verts.dedup();
+        if verts.is_empty() || f.normal == [0.0; 3] {
+            slabs.push(None);
+            continue;
+        }
+        for &v in &verts {
+            facets_of[v as usize].push(fi as u32);
+        }
+        let k = verts.len() as f64;
+        let mean: Point =
+            std::array::from_fn(|a| verts.iter().map(|&v| input[v as usize][a]).sum::<f64>() / k);
+        let mut slab = Slab {
+            normal: f.normal,
+            mean,
+            tol: 0.0,
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
+        };
+        let mut dev = 0.0f64;
+        for &v in &verts {
+            let p = &input[v as usize];
+            dev = dev.max(slab.height(p).abs());
+            for (a, &x) in p.iter().enumerate() {
+                slab.lo[a] = slab.lo[a].min(x);
+                slab.hi[a] = slab.hi[a].max(x);
+            }
+        }
+        slab.tol = (1e-10 * diag).max(4.0 * dev);
+        slabs.push(Some(slab));
+    }
+
+    let on = |orig: u32, p: &Point, f: u32| -> bool {
+        if (orig as usize) < n_input {
+            facets_of[orig as usize].contains(&f)
+        } else {
+            slabs[f as usize].as_ref().is_some_and(|s| s.holds(p))
+        }
+    };
+    let mut flat: Vec<(crate::mesh::TetId, u32)> = Vec::new();
+    for t in cdt.dt.mesh.live_tets() {
+        if cdt.is_ghost(t) {
+            continue;
+        }
+        let v = cdt.dt.mesh.verts(t);
+        let p = v.map(|x| cdt.dt.points[x as usize]);
+        if !is_flat(&p) {
+            continue;
+        }
+        let o = v.map(|x| cdt.dt.orig[x as usize]);
+        let candidates = o
+            .iter()
+            .filter(|&&x| (x as usize) < n_input)
+            .flat_map(|&x| facets_of[x as usize].iter().copied());
+        for f in candidates {
+            if (0..4).all(|i| on(o[i], &p[i], f)) {
+                flat.push((t, f));
+                break;
+            }
+        }
+    }
+    if flat.is_empty() {
+        return Vec::new();
+    }
+    let carved = carve(cdt, domain.holes, domain.regions, domain.keep_hull);
+    let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
+    let mut out: Vec<Point> = Vec::new();
+    for (t, f) in flat {
+        if !kept.contains(&t) {
+            continue;
+        }
+        let Some(slab) = slabs[f as usize].as_ref() else {
+            continue;
+        };
+        let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
+        if let Some(w) = remover(cdt, &kept, &p, slab, &slabs) {
+            if !out.contains(&w) {
+                out.push(w);
+            }
+        }
+    }
+    out
+}
+
+/// Whether the tet is flat by the [`FLAT`] measure.
+fn is_flat(p: &[Point; 4]) -> bool {
+    let mut l2 = 0.0f64;
+    for (i, j) in crate::mesh::EDGE_VERTS {
+        l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
+    }
+    let vol = orient3d(&p[0], &p[1], &p[2], &p[3]).abs() / 6.0;
+    vol <= FLAT * l2 * l2.sqrt()
+}
+
+/// A point inside the tet's circumsphere, off every facet's slab and inside a kept tet.
+/// It is sought on lines along the facet's normal through the tet's centroid, its
+/// circumcenter and the point halfway, farthest from the facet first: a flat tet along
+/// an edge where two facets meet has its sphere off to one side.
+fn remover(
+    cdt: &mut Cdt,
+    kept: &FxHashSet<crate::mesh::TetId>,
+    p: &[Point; 4],
+    slab: &Slab,
+    slabs: &[Option<Slab>],
+) -> Option<Point> {
+    let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
+    if o == 0.0 {
+        return None;
+    }
+    let mut l2 = 0.0f64;
+    for (i, j) in crate::mesh::EDGE_VERTS {
+        l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
+    }
+    let m: Point = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k] + p[3][k]) / 4.0);
+    let l = l2.sqrt();
+    let mut bases = vec![(m, l)];
+    if let Some((c, r)) = circumsphere(p) {
+        let h: Point = std::array::from_fn(|k| (c[k] + m[k]) / 2.0);
+        bases.push((c, r));
+        bases.push((h, r));
+    }
+    // Along an edge where facets meet, the point must leave all their slabs at once.
+    let mut dirs: Vec<Point> = vec![slab.normal];
+    let on: Vec<Point> = slabs
+        .iter()
+        .flatten()
+        .filter(|s| s.holds(&m))
+        .map(|s| s.normal)
+        .collect();
+    for n in &on {
+        for d in dirs.clone() {
+            for sg in [1.0, -1.0] {
+                let sum: Point = std::array::from_fn(|k| d[k] + sg * n[k]);
+                let len = (0..3).map(|k| sum[k] * sum[k]).sum::<f64>().sqrt();
+                if len > 1e-3 {
+                    dirs.push(sum.map(|x| x / len));
+                }
+            }
+        }
+        dirs.push(*n);
+    }
+    let inside = |w: &Point| insphere(&p[0], &p[1], &p[2], &p[3], w) * o.signum() > 0.0;
+    {
+        for frac in [0.5, 0.3, 0.15, 0.05, 0.0] {
+            for &(b, scale) in &bases {
+                for (d, s) in dirs.iter().flat_map(|d| [(d, 1.0), (d, -1.0)]) {
+                    let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
+                    // Off every facet's slab: near one it could form flat tets there.
+                    if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
+                        continue;
+                    }
+                    if containing_tet(cdt, &w).is_some_and(|t| kept.contains(&t)) {
+                        return Some(w);
+                    }
+                }
+            }
+        }
+    }
+    None
+}
+
+/// The tet's circumcenter and radius, when they are finite.
+fn circumsphere(p: &[Point; 4]) -> Option<(Point, f64)> {
+    let d: [Point; 3] = std::array::from_fn(|i| std::array::from_fn(|k| p[i + 1][k] - p[0][k]));
+    let n: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| d[i][k] * d[i][k]).sum());
+    let cross = |a: &Point, b: &Point| -> Point {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (c12, c20, c01) = (
+        cross(&d[1], &d[2]),
+        cross(&d[2], &d[0]),
+        cross(&d[0], &d[1]),
+    );
+    let det = 2.0 * (0..3).map(|k| d[0][k] * c12[k]).sum::<f64>();
+    let off: Point = std::array::from_fn(|k| (n[0] * c12[k] + n[1] * c20[k] + n[2] * c01[k]) / det);
+    let r = (0..3).map(|k| off[k] * off[k]).sum::<f64>().sqrt();
+    (r.is_finite() && det != 0.0).then(|| (std::array::from_fn(|k| p[0][k] + off[k]), r))
+}
+
+/// The length of the bounding box's diagonal (1 for a single point).
+fn diagonal(points: &[Point]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let d = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    if d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}
