@@ -42,6 +42,10 @@ impl Stats {
                 "    of them on polygons",
                 p.facet_steiner_points.to_string(),
             ),
+            (
+                "    of them free, inside the domain",
+                p.free_steiner_points.to_string(),
+            ),
             ("(4) output tetrahedra", p.output_tets.to_string()),
             ("(5) output subpolygons", p.output_subfaces.to_string()),
             (
@@ -144,10 +148,11 @@ impl Stats {
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 16] = [
+            let pairs: [(&str, String); 17] = [
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),
+                ("free_steiner_points", p.free_steiner_points.to_string()),
                 ("output_subfaces", p.output_subfaces.to_string()),
                 ("recovered_subfaces", p.recovered_subfaces.to_string()),
                 ("max_region_subfaces", p.max_region_subfaces.to_string()),

@@ -95,6 +95,8 @@ pub struct PlcStats {
     pub steiner_points: usize,
     /// Of those, the ones on polygons (for polygons that are not flat).
     pub facet_steiner_points: usize,
+    /// Of those, the free ones inside the domain (for flat tets at steps of facets).
+    pub free_steiner_points: usize,
     /// Output tets.
     pub output_tets: usize,
     /// Output subpolygons (triangles on input polygons).
@@ -246,7 +248,9 @@ pub fn mesh_plc_with_progress(
         };
         match outcome {
             Attempt::Done(cdt, seg_markers) => {
-                stats.facet_steiner_points = facet_points.len();
+                let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
+                stats.facet_steiner_points = facet_points.len() - free;
+                stats.free_steiner_points = free;
                 let (mesh, more) =
                     finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
                 warnings.extend(more);
