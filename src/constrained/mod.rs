@@ -163,6 +163,9 @@ const UNFLAT_GROUP: &str = "merged facets ";
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 24;
 
+/// Restarts after which flat tets no longer get free points (see [`slivers`]).
+const MAX_FREE_ROUNDS: usize = 12;
+
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
@@ -516,7 +519,8 @@ fn attempt(
     if steiner.is_empty() && splits.is_empty() {
         steiner.extend(resolve_shims(&mut cdt, plc, opts));
     }
-    if steiner.is_empty() && splits.is_empty() {
+    // Free points only improve a valid CDT: after a few rounds, keep what there is.
+    if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
         let domain = slivers::Domain {
             holes: &plc.holes,
             regions: &plc.regions,
