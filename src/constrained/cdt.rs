@@ -64,6 +64,12 @@ impl Cdt {
         self.face_index = self.dt.mesh.face_index();
     }
 
+    /// Like [`Cdt::index_faces`], for the faces whose vertices are all marked in `keep`
+    /// (the vertices of facets: only their faces are looked up).
+    pub fn index_faces_among(&mut self, keep: &[bool]) {
+        self.face_index = self.dt.mesh.face_index_among(Some(keep));
+    }
+
     /// True if `(a, b, c)` is a face of the mesh.
     pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
         if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {

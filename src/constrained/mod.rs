@@ -335,8 +335,29 @@ fn attempt(
     progress(Stage::Facets);
     let t2 = Instant::now();
     let inv = dt.internal_ids(points.len());
+    // Only triangles of facets are looked up: index the faces among facet vertices.
+    let mut on_facet = vec![false; dt.points.len()];
+    let mut mark = |v: u32| {
+        if let Some(m) = on_facet.get_mut(v as usize) {
+            *m = true;
+        }
+    };
+    for f in &prep.facets {
+        let inner = f.inner_segments.iter().flatten();
+        for &v in f.rings.iter().flatten().chain(inner).chain(&f.isolated) {
+            mark(inv[v as usize]);
+        }
+    }
+    for &v in subsegs.chains.iter().flatten() {
+        mark(v);
+    }
+    for (k, &(f, _)) in facet_points.iter().enumerate() {
+        if f != FREE_POINT {
+            mark(inv[n_input + k]);
+        }
+    }
     let mut cdt = Cdt::new(dt);
-    cdt.index_faces();
+    cdt.index_faces_among(&on_facet);
     let seg_index: FxHashMap<(u32, u32), usize> = prep
         .segments
         .iter()

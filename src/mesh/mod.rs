@@ -257,10 +257,29 @@ impl Mesh {
     /// Every face of the real tets, keyed by its sorted vertices, with one tet side of
     /// it: constant-time face lookups for as long as the mesh does not change.
     pub fn face_index(&self) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
+        self.face_index_among(None)
+    }
+
+    /// [`Mesh::face_index`] restricted to faces whose three vertices are all marked in
+    /// `keep` (all faces for `None`).
+    pub fn face_index_among(
+        &self,
+        keep: Option<&[bool]>,
+    ) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
         let mut index = rustc_hash::FxHashMap::default();
+        let kept = |x: VertexId| keep.is_none_or(|k| k.get(x as usize).copied().unwrap_or(false));
         for t in self.real_tets() {
             let v = self.verts(t);
+            let marked = [kept(v[0]), kept(v[1]), kept(v[2]), kept(v[3])];
             for (i, fv) in FACE_VERTS.iter().enumerate() {
+                if !fv.iter().all(|&j| marked[j]) {
+                    continue;
+                }
+                // Each face once: from the lower of its two real tets.
+                let n = self.adj(FaceRef::new(t, i)).tet();
+                if n < t && self.verts(n)[3] != GHOST {
+                    continue;
+                }
                 let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
                 k.sort_unstable();
                 index.insert(k, FaceRef::new(t, i));
