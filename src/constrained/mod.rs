@@ -253,7 +253,7 @@ pub fn mesh_plc_with_progress(
             Attempt::Done(cdt, seg_markers) => {
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
                 stats.facet_steiner_points = facet_points.len() - free;
-                stats.free_steiner_points = free;
+                stats.free_steiner_points += free;
                 let (mesh, more) =
                     finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
                 warnings.extend(more);
@@ -540,23 +540,83 @@ fn attempt(
     if steiner.is_empty() && splits.is_empty() {
         steiner.extend(resolve_shims(&mut cdt, plc, opts));
     }
-    // Free points only improve a valid CDT: after a few rounds, keep what there is.
+    stats.free_steiner_points = 0;
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
         let domain = slivers::Domain {
             holes: &plc.holes,
             regions: &plc.regions,
             keep_hull: opts.keep_hull,
         };
-        let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain);
-        if debug() && !free.is_empty() {
-            eprintln!("free points {free:?}");
+        // Free points go straight into the CDT, round after round; only if one cannot
+        // (its cavity would cross a constraint) does the construction start again with it.
+        for _ in 0..MAX_FREE_ROUNDS {
+            let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain);
+            if debug() && !free.is_empty() {
+                eprintln!("free points {free:?}");
+            }
+            if free.is_empty() {
+                break;
+            }
+            match insert_free(&mut cdt, &free, &mut next_pert) {
+                Ok(n) => stats.free_steiner_points += n,
+                Err(_) => {
+                    steiner.extend(free.into_iter().map(|p| (FREE_POINT, p)));
+                    break;
+                }
+            }
         }
-        steiner.extend(free.into_iter().map(|p| (FREE_POINT, p)));
+        stats.steiner_points += stats.free_steiner_points;
     }
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
     Ok(Attempt::Done(Box::new(cdt), seg_markers))
+}
+
+/// Inserts free points into the CDT, each with a cavity walled in by the subfaces, and
+/// returns how many it added. Fails if a cavity would cross a subface or remove a
+/// subsegment: the CDT is then broken and must be discarded.
+fn insert_free(cdt: &mut Cdt, free: &[Point], next_pert: &mut u32) -> Result<usize, MeshError> {
+    let mut at: FxHashMap<VertexId, Vec<VertexId>> = FxHashMap::default();
+    for &(a, b) in cdt.subsegs.keys() {
+        at.entry(a).or_default().push(b);
+        at.entry(b).or_default().push(a);
+    }
+    let mut cavity = Vec::new();
+    let mut added = 0;
+    for &w in free {
+        let subfaces = &cdt.subfaces;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            let fv = crate::mesh::FACE_VERTS[f];
+            subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
+        };
+        if cdt
+            .dt
+            .insert_steiner_blocked(w, *next_pert, blocked)?
+            .is_none()
+        {
+            continue;
+        }
+        if !cdt.dt.last_cavity_is_delaunay(blocked) {
+            return Err(MeshError::Internal(
+                "a free point's cavity is not constrained Delaunay".into(),
+            ));
+        }
+        *next_pert += 1;
+        added += 1;
+        // Only edges between vertices of the cavity can have gone.
+        cdt.dt.last_cavity_vertices(&mut cavity);
+        for &x in &cavity {
+            for &y in at.get(&x).map(|v| v.as_slice()).unwrap_or(&[]) {
+                if x < y && cavity.binary_search(&y).is_ok() && !cdt.has_edge(x, y) {
+                    return Err(MeshError::Internal(format!(
+                        "a free point removed subsegment ({x}, {y})"
+                    )));
+                }
+            }
+        }
+    }
+    Ok(added)
 }
 
 /// The triangles of `tris` on the inner side of `f`'s rings, flooding across edges that

@@ -247,6 +247,14 @@ impl Delaunay {
         }
     }
 
+    /// The sign of the orientation of a real tet (0 when flat).
+    fn orientation(&self, v: [VertexId; 4]) -> i8 {
+        let o = self
+            .filter
+            .orient3d(self.pt(v[0]), self.pt(v[1]), self.pt(v[2]), self.pt(v[3]));
+        (o > 0.0) as i8 - (o < 0.0) as i8
+    }
+
     /// Is tet `t` in conflict with point `p` (vertex id `pv`)?
     fn in_conflict(&self, t: TetId, p: &Point, pv: VertexId) -> bool {
         self.in_conflict_with(t, self.mesh.verts(t), p, pv)
@@ -309,6 +317,17 @@ impl Delaunay {
     /// Inserts vertex `pv` (already in `points`). Returns `Ok(false)` if it coincides with
     /// an existing vertex and was skipped.
     pub fn insert(&mut self, pv: VertexId) -> Result<bool, MeshError> {
+        self.insert_blocked(pv, |_, _| false)
+    }
+
+    /// [`Delaunay::insert`] whose cavity never grows across a face for which
+    /// `blocked(tet's vertices, face index)` holds: inserting a vertex into a constrained
+    /// Delaunay tetrahedralization, where the constraints hide what lies behind them.
+    pub fn insert_blocked(
+        &mut self,
+        pv: VertexId,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<bool, MeshError> {
         let p = *self.pt(pv);
         let [lo, hi] = self.bbox;
         if (0..3).any(|k| !(lo[k] <= p[k] && p[k] <= hi[k])) {
@@ -331,6 +350,7 @@ impl Delaunay {
         }
         self.mark[start as usize] = IN_CONFLICT;
         self.conflict.push(start);
+        let mut walled = false;
         let mut k = 0;
         while k < self.conflict.len() {
             let t = self.conflict[k];
@@ -348,7 +368,9 @@ impl Delaunay {
                     continue;
                 }
                 if state != OUTSIDE {
-                    if self.in_conflict_with(n, around[f], &p, pv) {
+                    if blocked(tet.v, f) {
+                        walled = true;
+                    } else if self.in_conflict_with(n, around[f], &p, pv) {
                         self.mark[n as usize] = IN_CONFLICT;
                         self.conflict.push(n);
                         continue;
@@ -363,6 +385,26 @@ impl Delaunay {
                     outside,
                 });
             }
+        }
+        // A cavity that reached both sides of a blocked face would destroy it; one that
+        // wrapped around a blocked face into tets hidden from the new vertex would make
+        // inverted tets (real tets all have the orientation of the one `p` lies in).
+        if walled
+            && (self.boundary.iter().any(|b| {
+                self.mark[b.outside.tet() as usize] == IN_CONFLICT
+                    || (b.v[3] != GHOST
+                        && self.orientation(b.v) != self.orientation(self.mesh.verts(start)))
+            }))
+        {
+            for i in 0..self.conflict.len() {
+                self.mark[self.conflict[i] as usize] = 0;
+            }
+            for i in 0..self.boundary.len() {
+                self.mark[self.boundary[i].outside.tet() as usize] = 0;
+            }
+            return Err(MeshError::Internal(
+                "the cavity of a vertex wraps around a constraint".into(),
+            ));
         }
         self.fill_cavity()
     }

@@ -10,6 +10,17 @@ impl Delaunay {
     /// Inserts a new point with perturbation (and output) index `pert`, which must exceed
     /// every index in use. Returns its vertex id, or `None` if it coincides with a vertex.
     pub fn insert_steiner(&mut self, p: Point, pert: u32) -> Result<Option<VertexId>, MeshError> {
+        self.insert_steiner_blocked(p, pert, |_, _| false)
+    }
+
+    /// [`Delaunay::insert_steiner`] with a cavity that never crosses a `blocked` face (see
+    /// [`Delaunay::insert_blocked`]).
+    pub fn insert_steiner_blocked(
+        &mut self,
+        p: Point,
+        pert: u32,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<Option<VertexId>, MeshError> {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(MeshError::Internal(format!(
                 "Steiner point {p:?} is not finite"
@@ -19,7 +30,7 @@ impl Delaunay {
         self.points.push(p);
         self.orig.push(pert);
         self.mesh.grow_vertices(self.points.len());
-        if !self.insert(v)? {
+        if !self.insert_blocked(v, blocked)? {
             self.points.pop();
             self.orig.pop();
             return Ok(None);
@@ -46,6 +57,25 @@ impl Delaunay {
         }
         out.sort_unstable();
         out.dedup();
+    }
+
+    /// Whether every face of the tets made by the last insertion is locally Delaunay,
+    /// except the `blocked` ones (constraints) and hull faces.
+    pub fn last_cavity_is_delaunay(&self, blocked: impl Fn([VertexId; 4], usize) -> bool) -> bool {
+        self.created.iter().all(|&(t, _)| {
+            let v = self.mesh.verts(t);
+            if v.contains(&GHOST) {
+                return true;
+            }
+            (0..4).all(|i| {
+                if blocked(v, i) {
+                    return true;
+                }
+                let n = self.mesh.adj(FaceRef::new(t, i));
+                let w = self.mesh.verts(n.tet())[n.face()];
+                w == GHOST || !self.in_sphere(t, &self.points[w as usize], w)
+            })
+        })
     }
 
     /// The internal vertex id of each of the first `n` input indices (`u32::MAX` for
