@@ -942,25 +942,28 @@ fn finish(
         .iter()
         .map(|&t| cdt.dt.mesh.verts(t).map(orig))
         .collect();
-    let mut subfaces = Vec::new();
-    let mut keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
-    keys.sort_unstable();
-    for (k, f) in keys {
-        let Some(fr) = cdt.find_face(k[0], k[1], k[2]) else {
-            continue;
-        };
-        let other = cdt.dt.mesh.adj(fr);
-        let (t, i) = if kept[fr.tet() as usize] {
-            (fr.tet(), fr.face())
-        } else if kept[other.tet() as usize] {
-            (other.tet(), other.face())
-        } else {
-            continue;
-        };
-        // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
-        let v = cdt.dt.mesh.face_verts(t, i).map(orig);
-        subfaces.push((v, prep.facets[f as usize].marker));
+    // One pass over the kept tets finds every subface with a kept side (a walk to each
+    // subface would cost more).
+    let mut found: Vec<([VertexId; 3], [u32; 3], i32)> = Vec::new();
+    for &t in &carved.tets {
+        let v = cdt.dt.mesh.verts(t);
+        for (i, fv) in crate::mesh::FACE_VERTS.iter().enumerate() {
+            let k = face_key([v[fv[0]], v[fv[1]], v[fv[2]]]);
+            let Some(&f) = cdt.subfaces.get(&k) else {
+                continue;
+            };
+            // A subface with two kept sides is written once, from its lower tet.
+            let n = cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet();
+            if kept[n as usize] && n < t {
+                continue;
+            }
+            // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
+            let w = cdt.dt.mesh.face_verts(t, i).map(orig);
+            found.push((k, w, prep.facets[f as usize].marker));
+        }
     }
+    found.sort_unstable_by_key(|x| x.0);
+    let subfaces: Vec<([u32; 3], i32)> = found.into_iter().map(|(_, w, m)| (w, m)).collect();
     let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
         .iter()
         .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))

@@ -150,8 +150,12 @@ fn is_flat(p: &[Point; 4]) -> bool {
     for (i, j) in crate::mesh::EDGE_VERTS {
         l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
     }
-    let vol = orient3d(&p[0], &p[1], &p[2], &p[3]).abs() / 6.0;
-    vol <= FLAT * l2 * l2.sqrt()
+    // A measure with a margin, not a sign: plain floating point does.
+    let d: [Point; 3] = std::array::from_fn(|i| std::array::from_fn(|k| p[i + 1][k] - p[0][k]));
+    let det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1])
+        - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0])
+        + d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+    det.abs() / 6.0 <= FLAT * l2 * l2.sqrt()
 }
 
 /// A point inside the tet's circumsphere, off every facet's slab and inside a kept tet.
