@@ -555,3 +555,29 @@ fn merged_facets_far_from_flat_mesh_with_few_shims() {
         }
     }
 }
+
+#[test]
+fn flat_tets_get_free_points_inserted_into_the_cdt() {
+    // anchor.off needs free points after cavity insertions have added tets; TetGen leaves
+    // shims on it.
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/anchor.off");
+    let dir = tempfile::tempdir().unwrap();
+    for (tag, args) in [("c", ["-pV", "--check"]), ("f", ["-pVF", "--check"])] {
+        let prefix = dir.path().join(tag);
+        let (code, err) = run(&m, &prefix, &args);
+        assert_eq!(code, 0, "{tag}: {err}");
+        if let Some(script) = validator() {
+            let out = std::process::Command::new("python3")
+                .arg(&script)
+                .arg(&m)
+                .arg(&prefix)
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{tag}: {}",
+                String::from_utf8_lossy(&out.stdout)
+            );
+        }
+    }
+}

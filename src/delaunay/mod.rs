@@ -341,6 +341,10 @@ impl Delaunay {
             Location::Vertex(_) => return Ok(false),
             Location::Inside(t) | Location::Outside(t) => t,
         };
+        // The constrained stages add tets behind this struct's back.
+        if self.mark.len() < self.mesh.num_slots() {
+            self.mark.resize(self.mesh.num_slots(), 0);
+        }
         self.conflict.clear();
         self.boundary.clear();
         if !self.in_conflict(start, &p, pv) {
