@@ -554,13 +554,18 @@ fn attempt(
             if debug() && !free.is_empty() {
                 eprintln!("free points {free:?}");
             }
+            // They only improve a valid CDT: within -S, or not at all.
+            let room = opts
+                .max_steiner
+                .saturating_sub(stats.steiner_points + stats.free_steiner_points);
+            let free = &free[..free.len().min(room)];
             if free.is_empty() {
                 break;
             }
-            match insert_free(&mut cdt, &free, &mut next_pert) {
+            match insert_free(&mut cdt, free, &mut next_pert) {
                 Ok(n) => stats.free_steiner_points += n,
                 Err(_) => {
-                    steiner.extend(free.into_iter().map(|p| (FREE_POINT, p)));
+                    steiner.extend(free.iter().map(|&p| (FREE_POINT, p)));
                     break;
                 }
             }
