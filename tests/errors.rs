@@ -187,6 +187,62 @@ fn fuzz_regression_twisted_quads_are_refused() {
     assert!(stderr.contains("is not flat"), "{stderr}");
 }
 
+/// Found by `tests/fuzz.rs`: `star.off` with one vertex moved 4.3e9 units away needs
+/// free points, and one was located in a hull tet, whose ghost vertex the orientation
+/// check of its walled cavity read.
+#[test]
+fn fuzz_regression_free_point_outside_the_hull() {
+    let text = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/star.off"))
+        .unwrap();
+    assert!(text.contains("\n-0.125 -0.125 -0.125\n"));
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(
+        dir.path().join("m.off"),
+        text.replacen(
+            "\n-0.125 -0.125 -0.125\n",
+            "\n-4294967295 -0.125 -0.125\n",
+            1,
+        ),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQ", "--check", "m.off"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+}
+
+/// Found by `tests/fuzz.rs`: `collinear_polygon.poly` with a vertex moved 4.3e9 units
+/// away gives sliver polygons whose Steiner points never settle, and each restart cost
+/// more exact predicates than the last (over a minute in all); the restarts' work is now
+/// bounded.
+#[test]
+fn fuzz_regression_far_vertex_restarts_are_bounded() {
+    let text = fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/broken/collinear_polygon.poly"),
+    )
+    .unwrap();
+    assert!(text.contains("\n7 1 1 1\n"));
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(
+        dir.path().join("m.poly"),
+        text.replace("\n7 1 1 1\n", "\n7 4294967295 1 1\n"),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQ", "m.poly"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("not flat"), "{stderr}");
+}
+
 #[test]
 fn duplicate_facet_exits_3() {
     refused(

@@ -427,6 +427,8 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     if v[3] == GHOST {
         return false;
     }
+    let tests = &cdt.crossing_tests;
+    tests.set(tests.get() + region.tris.len() as u64);
     EDGES
         .iter()
         .any(|&(i, j)| region.crossed_by(&cdt.dt.points, v[i], v[j]))

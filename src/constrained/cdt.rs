@@ -32,6 +32,8 @@ pub struct Cdt {
     /// hint that [`Cdt::has_face`] confirms in constant time while that tet is unchanged.
     face_index: FxHashMap<[VertexId; 3], FaceRef>,
     scratch: Vec<TetId>,
+    /// Edge-triangle crossing tests made so far: the work that bounds restarts.
+    pub crossing_tests: std::cell::Cell<u64>,
 }
 
 impl Cdt {
@@ -43,6 +45,7 @@ impl Cdt {
             subfaces: FxHashMap::default(),
             face_index: FxHashMap::default(),
             scratch: Vec::new(),
+            crossing_tests: std::cell::Cell::new(0),
         }
     }
 

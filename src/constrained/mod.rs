@@ -115,6 +115,8 @@ pub struct PlcStats {
     pub enlarged_tets: usize,
     /// Restarts caused by Steiner points on polygons.
     pub restarts: usize,
+    /// Edge-triangle crossing tests over all attempts (bounds the restarts' work).
+    pub crossing_tests: u64,
     /// Seconds for the Delaunay tetrahedralization.
     pub delaunay_secs: f64,
     /// Seconds for segment recovery.
@@ -162,6 +164,9 @@ const UNFLAT_GROUP: &str = "merged facets ";
 
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 24;
+
+/// Crossing tests that restarts may spend beyond eight times the first attempt's.
+const RESTART_WORK: u64 = 20_000_000;
 
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
 const MAX_FREE_ROUNDS: usize = 12;
@@ -217,6 +222,7 @@ pub fn mesh_plc_with_progress(
     // split points on segments: (segment, parameter).
     let mut facet_points: Vec<(usize, Point)> = Vec::new();
     let mut presplits: Vec<(usize, f64)> = Vec::new();
+    let mut first_work = 0u64;
     loop {
         let outcome = match attempt(
             plc,
@@ -265,6 +271,9 @@ pub fn mesh_plc_with_progress(
             }
             Attempt::Restart(more, splits) => {
                 stats.restarts += 1;
+                if stats.restarts == 1 {
+                    first_work = stats.crossing_tests;
+                }
                 if debug() {
                     eprintln!("restart {}", stats.restarts);
                 }
@@ -275,9 +284,12 @@ pub fn mesh_plc_with_progress(
                     ))
                     .into());
                 }
+                // Restarts may cost far more than the first attempt when the polygons'
+                // vertices are wildly off their planes: bound that work too.
                 if stats.restarts > MAX_RESTARTS
                     || facet_points.len() + more.len() + presplits.len() + splits.len()
                         > max_facet_points(plc)
+                    || stats.crossing_tests > RESTART_WORK + 8 * first_work
                 {
                     return Err(MeshError::Failed(format!(
                         "polygons that are not flat still conflict after {} Steiner points on them",
@@ -537,6 +549,7 @@ fn attempt(
         }
     }
     stats.facet_secs = t2.elapsed().as_secs_f64();
+    stats.crossing_tests += cdt.crossing_tests.get();
     if steiner.is_empty() && splits.is_empty() {
         steiner.extend(resolve_shims(&mut cdt, plc, opts));
     }

@@ -180,7 +180,9 @@ fn remover(
     let m: Point = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k] + p[3][k]) / 4.0);
     let l = l2.sqrt();
     let mut bases = vec![(m, l)];
-    if let Some((c, r)) = circumsphere(p) {
+    // A flat tet's circumcenter can lie arbitrarily far away; the point must stay near the
+    // tet, where it removes the tet and nothing far off.
+    if let Some((c, r)) = circumsphere(p).filter(|&(_, r)| r <= 2.0 * l) {
         let h: Point = std::array::from_fn(|k| (c[k] + m[k]) / 2.0);
         bases.push((c, r));
         bases.push((h, r));

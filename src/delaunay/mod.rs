@@ -392,13 +392,19 @@ impl Delaunay {
         }
         // A cavity that reached both sides of a blocked face would destroy it; one that
         // wrapped around a blocked face into tets hidden from the new vertex would make
-        // inverted tets (real tets all have the orientation of the one `p` lies in).
+        // inverted tets (real tets all have the orientation of the real tets it removes).
+        let reference = || {
+            self.conflict
+                .iter()
+                .map(|&t| self.mesh.verts(t))
+                .find(|v| v[3] != GHOST)
+                .map(|v| self.orientation(v))
+        };
         if walled
-            && (self.boundary.iter().any(|b| {
+            && self.boundary.iter().any(|b| {
                 self.mark[b.outside.tet() as usize] == IN_CONFLICT
-                    || (b.v[3] != GHOST
-                        && self.orientation(b.v) != self.orientation(self.mesh.verts(start)))
-            }))
+                    || (b.v[3] != GHOST && Some(self.orientation(b.v)) != reference())
+            })
         {
             for i in 0..self.conflict.len() {
                 self.mark[self.conflict[i] as usize] = 0;
