@@ -243,6 +243,35 @@ fn fuzz_regression_far_vertex_restarts_are_bounded() {
     assert!(stderr.contains("not flat"), "{stderr}");
 }
 
+/// Found by `tests/fuzz.rs`: `star.off` with a vertex moved 1.8e19 units away made the
+/// search for free points combine search directions without end until memory ran out.
+#[test]
+fn fuzz_regression_free_point_search_is_bounded() {
+    let text = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/star.off"))
+        .unwrap();
+    assert!(text.contains("\n0.125 -0.125 0.125\n"));
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(
+        dir.path().join("m.off"),
+        text.replacen(
+            "\n0.125 -0.125 0.125\n",
+            "\n18446744073709551616 -0.125 0.125\n",
+            1,
+        ),
+    )
+    .unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["-pQS20000", "m.off"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // A meshing failure with its reason, not an abort.
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("Steiner points"), "{stderr}");
+}
+
 #[test]
 fn duplicate_facet_exits_3() {
     refused(

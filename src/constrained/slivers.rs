@@ -182,30 +182,29 @@ fn remover(
     let mut bases = vec![(m, l)];
     // A flat tet's circumcenter can lie arbitrarily far away; the point must stay near the
     // tet, where it removes the tet and nothing far off.
-    if let Some((c, r)) = circumsphere(p).filter(|&(_, r)| r <= 2.0 * l) {
+    if let Some((c, r)) = circumsphere(p).filter(|&(_, r)| r <= 50.0 * l) {
         let h: Point = std::array::from_fn(|k| (c[k] + m[k]) / 2.0);
         bases.push((c, r));
         bases.push((h, r));
     }
-    // Along an edge where facets meet, the point must leave all their slabs at once.
+    // Along an edge where facets meet, the point must leave all their slabs at once:
+    // the facet's normal, each other facet's there, and their sums and differences.
     let mut dirs: Vec<Point> = vec![slab.normal];
-    let on: Vec<Point> = slabs
+    for n in slabs
         .iter()
         .flatten()
         .filter(|s| s.holds(&m))
         .map(|s| s.normal)
-        .collect();
-    for n in &on {
-        for d in dirs.clone() {
-            for sg in [1.0, -1.0] {
-                let sum: Point = std::array::from_fn(|k| d[k] + sg * n[k]);
-                let len = (0..3).map(|k| sum[k] * sum[k]).sum::<f64>().sqrt();
-                if len > 1e-3 {
-                    dirs.push(sum.map(|x| x / len));
-                }
+        .take(6)
+    {
+        for sg in [1.0, -1.0] {
+            let sum: Point = std::array::from_fn(|k| slab.normal[k] + sg * n[k]);
+            let len = (0..3).map(|k| sum[k] * sum[k]).sum::<f64>().sqrt();
+            if len > 1e-3 {
+                dirs.push(sum.map(|x| x / len));
             }
         }
-        dirs.push(*n);
+        dirs.push(n);
     }
     let inside = |w: &Point| insphere(&p[0], &p[1], &p[2], &p[3], w) * o.signum() > 0.0;
     {
