@@ -162,28 +162,41 @@ fn polygon_far_from_flat_exits_3() {
     );
 }
 
+/// Runs `tetcdt ARGS` on a copy of `data/MODEL` whose first `from` becomes `to` (one of
+/// the fuzzer's mutations); returns the exit code and stderr.
+fn mutated(model: &str, from: &str, to: &str, args: &[&str]) -> (Option<i32>, String) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(model);
+    let text = fs::read_to_string(&path).unwrap();
+    assert!(text.contains(from), "{model} has no {from:?}");
+    let name = path.file_name().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(dir.path().join(name), text.replacen(from, to, 1)).unwrap();
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(args)
+        .arg(name)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// Found by `tests/fuzz.rs`: a corner of `fig4_split.poly` moved 30 units away twists
 /// three quadrilaterals, which made cavity insertion fail with an internal error.
 #[test]
 fn fuzz_regression_twisted_quads_are_refused() {
-    let text =
-        fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/fig4_split.poly"))
-            .unwrap();
-    assert!(text.contains("\n5 1 -1 -1e-05\n"));
-    let dir = tempfile::tempdir().unwrap();
-    fs::write(
-        dir.path().join("m.poly"),
-        text.replace("\n5 1 -1 -1e-05\n", "\n5 1 -31 -1e-05\n"),
-    )
-    .unwrap();
-    let out = Command::cargo_bin("tetcdt")
-        .unwrap()
-        .current_dir(dir.path())
-        .args(["-pQ", "m.poly"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    let (code, stderr) = mutated(
+        "plc/fig4_split.poly",
+        "\n5 1 -1 -1e-05\n",
+        "\n5 1 -31 -1e-05\n",
+        &["-pQ"],
+    );
+    assert_eq!(code, Some(3), "{stderr}");
     assert!(stderr.contains("is not flat"), "{stderr}");
 }
 
@@ -192,27 +205,13 @@ fn fuzz_regression_twisted_quads_are_refused() {
 /// check of its walled cavity read.
 #[test]
 fn fuzz_regression_free_point_outside_the_hull() {
-    let text = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/star.off"))
-        .unwrap();
-    assert!(text.contains("\n-0.125 -0.125 -0.125\n"));
-    let dir = tempfile::tempdir().unwrap();
-    fs::write(
-        dir.path().join("m.off"),
-        text.replacen(
-            "\n-0.125 -0.125 -0.125\n",
-            "\n-4294967295 -0.125 -0.125\n",
-            1,
-        ),
-    )
-    .unwrap();
-    let out = Command::cargo_bin("tetcdt")
-        .unwrap()
-        .current_dir(dir.path())
-        .args(["-pQ", "--check", "m.off"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let (code, stderr) = mutated(
+        "plc/star.off",
+        "\n-0.125 -0.125 -0.125\n",
+        "\n-4294967295 -0.125 -0.125\n",
+        &["-pQ", "--check"],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
 }
 
 /// Found by `tests/fuzz.rs`: `collinear_polygon.poly` with a vertex moved 4.3e9 units
@@ -221,25 +220,13 @@ fn fuzz_regression_free_point_outside_the_hull() {
 /// bounded.
 #[test]
 fn fuzz_regression_far_vertex_restarts_are_bounded() {
-    let text = fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/broken/collinear_polygon.poly"),
-    )
-    .unwrap();
-    assert!(text.contains("\n7 1 1 1\n"));
-    let dir = tempfile::tempdir().unwrap();
-    fs::write(
-        dir.path().join("m.poly"),
-        text.replace("\n7 1 1 1\n", "\n7 4294967295 1 1\n"),
-    )
-    .unwrap();
-    let out = Command::cargo_bin("tetcdt")
-        .unwrap()
-        .current_dir(dir.path())
-        .args(["-pQ", "m.poly"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let (code, stderr) = mutated(
+        "broken/collinear_polygon.poly",
+        "\n7 1 1 1\n",
+        "\n7 4294967295 1 1\n",
+        &["-pQ"],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("not flat"), "{stderr}");
 }
 
@@ -247,28 +234,14 @@ fn fuzz_regression_far_vertex_restarts_are_bounded() {
 /// search for free points combine search directions without end until memory ran out.
 #[test]
 fn fuzz_regression_free_point_search_is_bounded() {
-    let text = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/star.off"))
-        .unwrap();
-    assert!(text.contains("\n0.125 -0.125 0.125\n"));
-    let dir = tempfile::tempdir().unwrap();
-    fs::write(
-        dir.path().join("m.off"),
-        text.replacen(
-            "\n0.125 -0.125 0.125\n",
-            "\n18446744073709551616 -0.125 0.125\n",
-            1,
-        ),
-    )
-    .unwrap();
-    let out = Command::cargo_bin("tetcdt")
-        .unwrap()
-        .current_dir(dir.path())
-        .args(["-pQS20000", "m.off"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let (code, stderr) = mutated(
+        "plc/star.off",
+        "\n0.125 -0.125 0.125\n",
+        "\n18446744073709551616 -0.125 0.125\n",
+        &["-pQS20000"],
+    );
     // A meshing failure with its reason, not an abort.
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("Steiner points"), "{stderr}");
 }
 

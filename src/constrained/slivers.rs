@@ -146,10 +146,7 @@ pub(crate) fn free_points(
 
 /// Whether the tet is flat by the [`FLAT`] measure.
 fn is_flat(p: &[Point; 4]) -> bool {
-    let mut l2 = 0.0f64;
-    for (i, j) in crate::mesh::EDGE_VERTS {
-        l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
-    }
+    let l2 = longest_edge2(p);
     // A measure with a margin, not a sign: plain floating point does.
     let d: [Point; 3] = std::array::from_fn(|i| std::array::from_fn(|k| p[i + 1][k] - p[0][k]));
     let det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1])
@@ -173,10 +170,7 @@ fn remover(
     if o == 0.0 {
         return None;
     }
-    let mut l2 = 0.0f64;
-    for (i, j) in crate::mesh::EDGE_VERTS {
-        l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
-    }
+    let l2 = longest_edge2(p);
     let m: Point = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k] + p[3][k]) / 4.0);
     let l = l2.sqrt();
     let mut bases = vec![(m, l)];
@@ -250,18 +244,19 @@ fn circumsphere(p: &[Point; 4]) -> Option<(Point, f64)> {
 
 /// The length of the bounding box's diagonal (1 for a single point).
 fn diagonal(points: &[Point]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let [lo, hi] = crate::geom::bounding_box(points);
     let d = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     if d > 0.0 {
         d
     } else {
         1.0
     }
+}
+
+/// The square of the tet's longest edge.
+fn longest_edge2(p: &[Point; 4]) -> f64 {
+    crate::mesh::EDGE_VERTS
+        .iter()
+        .map(|&(i, j)| (0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum::<f64>())
+        .fold(0.0, f64::max)
 }
