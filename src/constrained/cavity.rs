@@ -885,14 +885,8 @@ fn largest_centroid(cdt: &Cdt, tris: &[[VertexId; 3]]) -> Point {
     let p = |v: VertexId| cdt.dt.points[v as usize];
     let area2 = |t: &[VertexId; 3]| {
         let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+        let n = crate::geom::cross(&crate::geom::sub(&b, &a), &crate::geom::sub(&c, &a));
+        crate::geom::dot(&n, &n)
     };
     let t = tris
         .iter()

@@ -813,11 +813,7 @@ fn bbox(it: impl Iterator<Item = Point>) -> (Point, Point) {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    crate::geom::cross(&a, &b)
 }
 
 fn unit(a: [f64; 3]) -> [f64; 3] {
@@ -954,12 +950,7 @@ mod tests {
         default * k.max(1)
     }
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     fn shuffle<T>(v: &mut [T], s: &mut u64) {
         for i in (1..v.len()).rev() {

@@ -25,7 +25,7 @@ use crate::error::MeshError;
 use crate::geom::lifted::{
     cross_sign, key_cross, Approx, CompareCounts, FlipTime, Lifting, TimeKey,
 };
-use crate::geom::{insphere_sos, orient3d, Point, Sign};
+use crate::geom::{cross, dot, insphere_sos, orient3d, sub, Point, Sign};
 use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
 use rustc_hash::FxHashSet;
 
@@ -235,14 +235,8 @@ fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
         .max_by(|x, y| d2(*x, a).total_cmp(&d2(*y, a)))
         .unwrap_or(a);
     let area = |c: Point| {
-        let u: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
-        let w: [f64; 3] = std::array::from_fn(|k| c[k] - a[k]);
-        let n = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+        let n = cross(&sub(&b, &a), &sub(&c, &a));
+        dot(&n, &n)
     };
     let c = verts
         .iter()
@@ -571,9 +565,10 @@ impl<'a> Flipper<'a> {
         l && r
     }
 
-    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last),
-    /// if it ever flips.
-    fn flip_time_if_flips(&self, f: FaceRef) -> Option<FlipTime> {
+    /// What the flip certificate of face `f` needs (seen from its tet, apex of the other
+    /// tet last): the five points, their perturbation indices, which are left, and their
+    /// heights.
+    fn certificate(&self, f: FaceRef) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
         let mesh = &self.cdt.dt.mesh;
         let g = mesh.adj(f);
         let s = mesh.face_verts(f.tet(), f.face());
@@ -584,22 +579,19 @@ impl<'a> Flipper<'a> {
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
         let zero = Approx { v: 0.0, p: 0.0 };
         let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
-        FlipTime::if_flips(&self.lift, pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+        (pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
     }
 
-    /// The flip certificate of face `f` (seen from its tet, apex of the other tet last).
+    /// The flip certificate of face `f`, if it ever flips.
+    fn flip_time_if_flips(&self, f: FaceRef) -> Option<FlipTime> {
+        let (pts, orig, left, heights) = self.certificate(f);
+        FlipTime::if_flips(&self.lift, pts, orig, left, heights)
+    }
+
+    /// The flip certificate of face `f`.
     fn flip_time(&self, f: FaceRef) -> FlipTime {
-        let mesh = &self.cdt.dt.mesh;
-        let g = mesh.adj(f);
-        let s = mesh.face_verts(f.tet(), f.face());
-        let v = mesh.verts(f.tet())[f.face()];
-        let w = mesh.verts(g.tet())[g.face()];
-        let ids = [s[0], s[1], s[2], v, w];
-        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
-        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
-        let zero = Approx { v: 0.0, p: 0.0 };
-        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
-        FlipTime::new(pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+        let (pts, orig, left, heights) = self.certificate(f);
+        FlipTime::new(pts, orig, left, heights)
     }
 
     /// Queues the flip of crossing face `f` if it ever happens.
@@ -967,12 +959,7 @@ mod tests {
     use super::*;
     use crate::delaunay::Delaunay;
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     /// Points near the plane z = 0 and a big triangle in it, as the Figure 9 experiment:
     /// inserted by flips, the result is a valid arena, keeps every vertex, has the

@@ -182,16 +182,20 @@ pub fn mesh_plc_with_progress(
     opts: &PlcOptions,
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
-    let mut prep = prepare(plc, opts.merge)?;
+    let base = prepare(plc, opts.merge)?;
     // Flat tets are judged on the facets as merged by default, whatever the switches and
     // the splitting of groups below did.
-    let merged = if opts.merge {
-        prep.clone()
+    let all_merged = if opts.merge {
+        None
     } else {
-        prepare(plc, true)?
+        Some(prepare(plc, true)?)
     };
+    let merged = all_merged.as_ref().unwrap_or(&base);
+    // `base` with the groups that could not be triangulated in one plane kept apart.
+    let mut split: Option<PreparedPlc> = None;
+    let prep = &base;
     // The message lists the boundary edges in the input's own terms.
-    if !opts.keep_hull && enclosure::open_boundary(plc, &prep).is_some() {
+    if !opts.keep_hull && enclosure::open_boundary(plc, prep).is_some() {
         return Err(crate::error::InputError::Invalid {
             file: plc.source.clone(),
             msg: crate::precheck::empty_domain_message(plc),
@@ -224,9 +228,10 @@ pub fn mesh_plc_with_progress(
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     let mut first_work = 0u64;
     loop {
+        let prep = split.as_ref().unwrap_or(&base);
         let outcome = match attempt(
             plc,
-            [&prep, &merged],
+            [prep, merged],
             &facet_points,
             &presplits,
             opts,
@@ -248,7 +253,7 @@ pub fn mesh_plc_with_progress(
                 keep_apart.extend(sources);
                 keep_apart.sort_unstable();
                 keep_apart.dedup();
-                prep = prepare::prepare_except(plc, opts.merge, &keep_apart)?;
+                split = Some(prepare::prepare_except(plc, opts.merge, &keep_apart)?);
                 facet_points.clear();
                 presplits.clear();
                 continue;
@@ -261,7 +266,7 @@ pub fn mesh_plc_with_progress(
                 stats.facet_steiner_points = facet_points.len() - free;
                 stats.free_steiner_points += free;
                 let (mesh, more) =
-                    finish(plc, &prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
+                    finish(plc, prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
                 warnings.extend(more);
                 return Ok(PlcMesh {
                     mesh,

@@ -421,12 +421,7 @@ fn reference_split(
 mod tests {
     use super::*;
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     #[test]
     fn long_segments_through_a_cloud_are_recovered() {

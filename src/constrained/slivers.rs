@@ -10,7 +10,7 @@ use super::cdt::Cdt;
 use super::prepare::PreparedPlc;
 use crate::carve::{carve, containing_tet};
 use crate::geom::predicates::{insphere, orient3d};
-use crate::geom::Point;
+use crate::geom::{cross, dot, sub, Point};
 use crate::plc::Region;
 use rustc_hash::FxHashSet;
 
@@ -54,6 +54,17 @@ pub(crate) fn free_points(
     input: &[Point],
     domain: &Domain<'_>,
 ) -> Vec<Point> {
+    // Flat tets are few: find them before building the facets' slabs.
+    let flat_tets: Vec<crate::mesh::TetId> = cdt
+        .dt
+        .mesh
+        .live_tets()
+        .filter(|&t| !cdt.is_ghost(t))
+        .filter(|&t| is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize])))
+        .collect();
+    if flat_tets.is_empty() {
+        return Vec::new();
+    }
     let n_input = input.len();
     let diag = diagonal(input);
     let mut facets_of: Vec<Vec<u32>> = vec![Vec::new(); n_input];
@@ -100,15 +111,9 @@ pub(crate) fn free_points(
         }
     };
     let mut flat: Vec<(crate::mesh::TetId, u32)> = Vec::new();
-    for t in cdt.dt.mesh.live_tets() {
-        if cdt.is_ghost(t) {
-            continue;
-        }
+    for t in flat_tets {
         let v = cdt.dt.mesh.verts(t);
         let p = v.map(|x| cdt.dt.points[x as usize]);
-        if !is_flat(&p) {
-            continue;
-        }
         let o = v.map(|x| cdt.dt.orig[x as usize]);
         let candidates = o
             .iter()
@@ -222,23 +227,16 @@ fn remover(
 
 /// The tet's circumcenter and radius, when they are finite.
 fn circumsphere(p: &[Point; 4]) -> Option<(Point, f64)> {
-    let d: [Point; 3] = std::array::from_fn(|i| std::array::from_fn(|k| p[i + 1][k] - p[0][k]));
-    let n: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| d[i][k] * d[i][k]).sum());
-    let cross = |a: &Point, b: &Point| -> Point {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
+    let d: [Point; 3] = std::array::from_fn(|i| sub(&p[i + 1], &p[0]));
+    let n: [f64; 3] = d.map(|x| dot(&x, &x));
     let (c12, c20, c01) = (
         cross(&d[1], &d[2]),
         cross(&d[2], &d[0]),
         cross(&d[0], &d[1]),
     );
-    let det = 2.0 * (0..3).map(|k| d[0][k] * c12[k]).sum::<f64>();
+    let det = 2.0 * dot(&d[0], &c12);
     let off: Point = std::array::from_fn(|k| (n[0] * c12[k] + n[1] * c20[k] + n[2] * c01[k]) / det);
-    let r = (0..3).map(|k| off[k] * off[k]).sum::<f64>().sqrt();
+    let r = dot(&off, &off).sqrt();
     (r.is_finite() && det != 0.0).then(|| (std::array::from_fn(|k| p[0][k] + off[k]), r))
 }
 

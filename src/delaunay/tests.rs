@@ -1,12 +1,7 @@
 use super::*;
 use crate::geom::insphere_sos;
 
-fn lcg(seed: &mut u64) -> f64 {
-    *seed = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*seed >> 11) as f64 / (1u64 << 53) as f64
-}
+use crate::geom::lcg;
 
 fn random_points(n: usize, seed: u64) -> Vec<Point> {
     let mut s = seed;

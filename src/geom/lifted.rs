@@ -481,12 +481,7 @@ mod tests {
     use super::*;
     use crate::geom::{insphere, insphere_sos, orient3d, Sign};
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     #[test]
     fn values_agree_with_the_predicates() {

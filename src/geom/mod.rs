@@ -7,6 +7,37 @@ pub mod predicates;
 
 pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign, StaticFilter};
 
+/// `a - b`.
+#[inline]
+pub fn sub(a: &Point, b: &Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The cross product `a × b`.
+#[inline]
+pub fn cross(a: &Point, b: &Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The dot product `a · b`.
+#[inline]
+pub fn dot(a: &Point, b: &Point) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A deterministic pseudo-random number in [0, 1) (an LCG), for tests.
+#[cfg(test)]
+pub(crate) fn lcg(s: &mut u64) -> f64 {
+    *s = s
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*s >> 11) as f64 / (1u64 << 53) as f64
+}
+
 /// The smallest box holding `points`, as `[lo, hi]` (an empty box for no points).
 pub fn bounding_box(points: &[Point]) -> [Point; 2] {
     let mut lo = [f64::INFINITY; 3];

@@ -414,12 +414,7 @@ mod tests {
         );
     }
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     /// The filtered predicates must agree in sign with the exact ones, also on nearly
     /// degenerate input where the filter must give up.
