@@ -206,18 +206,16 @@ fn remover(
         dirs.push(n);
     }
     let inside = |w: &Point| insphere(&p[0], &p[1], &p[2], &p[3], w) * o.signum() > 0.0;
-    {
-        for frac in [0.5, 0.3, 0.15, 0.05, 0.0] {
-            for &(b, scale) in &bases {
-                for (d, s) in dirs.iter().flat_map(|d| [(d, 1.0), (d, -1.0)]) {
-                    let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
-                    // Off every facet's slab: near one it could form flat tets there.
-                    if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
-                        continue;
-                    }
-                    if containing_tet(cdt, &w).is_some_and(|t| kept.contains(&t)) {
-                        return Some(w);
-                    }
+    for frac in [0.5, 0.3, 0.15, 0.05, 0.0] {
+        for &(b, scale) in &bases {
+            for (d, s) in dirs.iter().flat_map(|d| [(d, 1.0), (d, -1.0)]) {
+                let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
+                // Off every facet's slab: near one it could form flat tets there.
+                if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
+                    continue;
+                }
+                if containing_tet(cdt, &w).is_some_and(|t| kept.contains(&t)) {
+                    return Some(w);
                 }
             }
         }
