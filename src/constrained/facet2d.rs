@@ -745,6 +745,34 @@ pub fn triangulate_facet(
     run(g, n, &order, &cons, holes.len(), &ids)
 }
 
+/// The output of [`triangulate_facet`] for a facet that is one triangle without holes,
+/// computed directly (most facets of surface meshes are), or `None` when its projection
+/// is degenerate and the general routine must decide.
+pub fn single_triangle(points: &[Point], tri: [u32; 3], normal: [f64; 3]) -> Option<[u32; 3]> {
+    let k = (0..3)
+        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+        .unwrap_or(2);
+    let (mut ax, mut ay) = ((k + 1) % 3, (k + 2) % 3);
+    if normal[k] < 0.0 {
+        std::mem::swap(&mut ax, &mut ay);
+    }
+    let p = |v: u32| {
+        let q = points.get(v as usize)?;
+        Some([q[ax], q[ay]])
+    };
+    let (a, b, c) = (p(tri[0])?, p(tri[1])?, p(tri[2])?);
+    let s = robust::orient2d(c2(&a), c2(&b), c2(&c));
+    let t = if s > 0.0 {
+        tri
+    } else if s < 0.0 {
+        [tri[0], tri[2], tri[1]]
+    } else {
+        return None;
+    };
+    let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+    Some([t[m], t[nx(m)], t[pv(m)]])
+}
+
 /// Vertices farther than this (relative to the facet's extent) from the plane make the
 /// facet "not flat": it is then triangulated in 2D after an orthogonal projection, since
 /// the apex-relative in-circle test amplifies deviations from the plane.
@@ -951,6 +979,43 @@ mod tests {
     }
 
     use crate::geom::lcg;
+
+    #[test]
+    fn single_triangles_match_the_general_routine() {
+        let mut s = 7u64;
+        let mut checked = 0;
+        for round in 0..rounds(2000) {
+            let mut pts: Vec<Point> = (0..3)
+                .map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)])
+                .collect();
+            if round % 3 == 0 {
+                // Axis-parallel facets take another path in the general routine.
+                for p in &mut pts {
+                    p[round % 2] = 0.5;
+                }
+            }
+            let ids = [0u32, 1, 2];
+            let pert = [5u32, 3, 9];
+            let (u, v) = (
+                crate::geom::sub(&pts[1], &pts[0]),
+                crate::geom::sub(&pts[2], &pts[0]),
+            );
+            let mut n = cross(u, v);
+            if round % 2 == 1 {
+                n = n.map(|x| -x);
+            }
+            let cons = [[0u32, 1], [1, 2], [2, 0]];
+            let want = triangulate_facet(&pts, &pert, &ids, &cons, &[], n);
+            match single_triangle(&pts, [2, 0, 1], n) {
+                Some(t) => {
+                    assert_eq!(want.unwrap(), vec![t], "round {round}");
+                    checked += 1;
+                }
+                None => assert!(want.map(|w| w.is_empty()).unwrap_or(true)),
+            }
+        }
+        assert!(checked > 100);
+    }
 
     fn shuffle<T>(v: &mut [T], s: &mut u64) {
         for i in (1..v.len()).rev() {

@@ -457,14 +457,24 @@ fn attempt(
         if f.rings.is_empty() {
             continue;
         }
-        let mut tris = facet2d::triangulate_facet(
-            &cdt.dt.points,
-            &cdt.dt.orig,
-            &verts,
-            &constraints,
-            &f.holes,
-            f.normal,
-        )
+        // Most facets of surface meshes are single triangles: no 2D CDT for them.
+        let single = match (&f.rings[..], verts.len()) {
+            ([ring], 3) if f.holes.is_empty() && f.source_facets.len() == 1 && ring.len() == 3 => {
+                facet2d::single_triangle(&cdt.dt.points, [0, 1, 2].map(|k| verts[k]), f.normal)
+            }
+            _ => None,
+        };
+        let mut tris = match single {
+            Some(t) => Ok(vec![t]),
+            None => facet2d::triangulate_facet(
+                &cdt.dt.points,
+                &cdt.dt.orig,
+                &verts,
+                &constraints,
+                &f.holes,
+                f.normal,
+            ),
+        }
         .map_err(|e| {
             if debug() {
                 eprintln!(
