@@ -91,10 +91,34 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             crate::options::FacetAlgo::Cavity => crate::constrained::FacetInserter::Cavity,
             crate::options::FacetAlgo::Flip => crate::constrained::FacetInserter::Flip,
         },
+        cancel: None,
     };
-    let mut warnings = crate::precheck::check(plc)?;
-    let precheck_secs = start.elapsed().as_secs_f64();
-    let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress)?;
+    // The checks of single elements come first: meshing relies on them. The surface
+    // checks (intersecting facets) run on a second core alongside meshing, and stop it
+    // if they find the input invalid; their error then wins.
+    let rep = crate::precheck::check_elements(plc)?;
+    let cancel = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let popts = crate::constrained::PlcOptions {
+        cancel: Some(cancel.clone()),
+        ..popts
+    };
+    let (checked, done) = std::thread::scope(|s| {
+        let checker = s.spawn(|| {
+            let r = crate::precheck::check_surface(plc, &rep);
+            if r.is_err() {
+                cancel.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+            (r, start.elapsed().as_secs_f64())
+        });
+        let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress);
+        let checked = checker
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (checked, done)
+    });
+    let (checked, precheck_secs) = checked;
+    let mut warnings = checked?;
+    let done = done?;
     warnings.extend(done.warnings);
     let ps = done.stats;
     let stats = Stats {

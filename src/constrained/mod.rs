@@ -27,6 +27,8 @@ use cavity::{insert_region, Outcome};
 use cdt::{edge_key, face_key, Cdt};
 use prepare::{prepare, PreparedPlc};
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What `-p` meshing needs to know beyond the PLC.
@@ -42,6 +44,28 @@ pub struct PlcOptions {
     pub max_steiner: usize,
     /// How missing regions are inserted (`-C` / `-F`).
     pub inserter: FacetInserter,
+    /// Set by another thread to stop the run early (the checks before meshing, run
+    /// alongside, found the input invalid): the run then fails with [`CANCELLED`].
+    pub cancel: Option<Arc<AtomicBool>>,
+}
+
+/// The failure of a run stopped through [`PlcOptions::cancel`].
+pub const CANCELLED: &str = "stopped: the input is invalid";
+
+impl PlcOptions {
+    /// Fails if the run has been told to stop.
+    fn check_cancel(&self) -> Result<(), MeshError> {
+        match &self.cancel {
+            Some(c) if c.load(Ordering::Relaxed) => Err(MeshError::Failed(CANCELLED.into())),
+            _ => Ok(()),
+        }
+    }
+
+    /// The stop flag, or one never set.
+    fn cancel_flag(&self) -> &AtomicBool {
+        static NEVER: AtomicBool = AtomicBool::new(false);
+        self.cancel.as_deref().unwrap_or(&NEVER)
+    }
 }
 
 /// The facet insertion algorithm: both insert one missing region at a time, with the
@@ -80,6 +104,7 @@ impl Default for PlcOptions {
             region_attributes: false,
             max_steiner: 10_000_000,
             inserter: FacetInserter::Cavity,
+            cancel: None,
         }
     }
 }
@@ -228,6 +253,7 @@ pub fn mesh_plc_with_progress(
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     let mut first_work = 0u64;
     loop {
+        opts.check_cancel()?;
         let prep = split.as_ref().unwrap_or(&base);
         let outcome = match attempt(
             plc,
@@ -345,6 +371,7 @@ fn attempt(
         &mut next_pert,
         budget,
         presplits,
+        opts.cancel_flag(),
     )?;
     stats.segment_secs = t1.elapsed().as_secs_f64();
     stats.steiner_points = facet_points.len() + subsegs.steiner_points;
@@ -416,6 +443,7 @@ fn attempt(
     let mut rounds = 0usize;
     let max_rounds = 20 * prep.facets.len() + 1000;
     while let Some(fi) = queue.pop() {
+        opts.check_cancel()?;
         queued.remove(&fi);
         rounds += 1;
         if rounds > max_rounds {
@@ -1060,4 +1088,28 @@ fn finish(
         ..Default::default()
     };
     Ok((mesh, warnings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cancelled_run_stops_with_its_own_error() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/examples/box_with_hole.poly");
+        let plc = crate::io::read_plc(&path).unwrap();
+        let flag = Arc::new(AtomicBool::new(false));
+        let opts = PlcOptions {
+            cancel: Some(flag.clone()),
+            ..Default::default()
+        };
+        assert!(mesh_plc(&plc, &opts).is_ok());
+        flag.store(true, Ordering::Relaxed);
+        match mesh_plc(&plc, &opts) {
+            Err(Error::Mesh(MeshError::Failed(m))) => assert_eq!(m, CANCELLED),
+            Err(e) => panic!("unexpected error {e}"),
+            Ok(_) => panic!("a cancelled run meshed"),
+        }
+    }
 }

@@ -44,6 +44,7 @@ pub fn recover_segments(
     next_pert: &mut u32,
     max_steiner: usize,
     presplits: &[(usize, f64)],
+    cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<Subsegments, MeshError> {
     let inv = dt.internal_ids(n_input);
     let mut ends = Vec::with_capacity(segments.len());
@@ -129,6 +130,9 @@ pub fn recover_segments(
             {
                 done.push(pc);
                 continue;
+            }
+            if cancel.load(std::sync::atomic::Ordering::Relaxed) {
+                return Err(MeshError::Failed(super::CANCELLED.into()));
             }
             if steiner >= max_steiner {
                 return Err(MeshError::Failed(format!(
@@ -436,7 +440,16 @@ mod tests {
         let mut dt = Delaunay::build(&pts).unwrap().dt;
         let mut next = pts.len() as u32;
         let segs = [[400, 401], [400, 402]];
-        let rec = recover_segments(&mut dt, &segs, pts.len(), &mut next, 10_000, &[]).unwrap();
+        let rec = recover_segments(
+            &mut dt,
+            &segs,
+            pts.len(),
+            &mut next,
+            10_000,
+            &[],
+            &Default::default(),
+        )
+        .unwrap();
         assert!(rec.steiner_points > 0);
         dt.mesh.check_links().unwrap();
         let mut scratch = Vec::new();
@@ -471,7 +484,16 @@ mod tests {
         ]);
         let mut dt = Delaunay::build(&pts).unwrap().dt;
         let mut next = pts.len() as u32;
-        let e = recover_segments(&mut dt, &[[0, 1]], pts.len(), &mut next, 100, &[]).unwrap_err();
+        let e = recover_segments(
+            &mut dt,
+            &[[0, 1]],
+            pts.len(),
+            &mut next,
+            100,
+            &[],
+            &Default::default(),
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("passes through"), "{e}");
     }
 }

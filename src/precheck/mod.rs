@@ -183,9 +183,15 @@ fn out_of_range(c: f64) -> bool {
 /// first defect found is the error.
 pub fn check(plc: &Plc) -> Result<Vec<String>, InputError> {
     let rep = check_elements(plc)?;
-    check_duplicates(plc, &rep)?;
+    check_surface(plc, &rep)
+}
+
+/// The checks of the surface as a whole (duplicate and intersecting facets), once
+/// [`check_elements`] has passed and given the representatives `rep`.
+pub fn check_surface(plc: &Plc, rep: &[u32]) -> Result<Vec<String>, InputError> {
+    check_duplicates(plc, rep)?;
     let mut warnings = Vec::new();
-    let found = intersections(plc, &rep, &mut warnings);
+    let found = intersections(plc, rep, &mut warnings);
     if !found.pairs.is_empty() {
         return Err(invalid(plc, intersection_message(plc, &found.pairs)));
     }
