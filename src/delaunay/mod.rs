@@ -34,6 +34,9 @@ pub struct Delaunay {
     /// Per tet slot, what the current insertion knows of it (`IN_CONFLICT`, ...); reset
     /// after every insertion. One byte a slot keeps the array in cache.
     mark: Vec<u8>,
+    /// Per tet slot, the walk that last visited it (see [`Delaunay::find_around`]), and
+    /// the current walk's stamp: a star walk then tests membership in O(1).
+    visit: std::cell::RefCell<(Vec<u32>, u32)>,
     /// Where the next point location starts.
     last: TetId,
     rng: u64,
@@ -91,6 +94,7 @@ impl Delaunay {
             points: order.order.iter().map(|&i| points[i as usize]).collect(),
             orig: order.order,
             mark: Vec::new(),
+            visit: Default::default(),
             last: 0,
             rng: 0x2545_F491_4F6C_DD1D,
             conflict: Vec::new(),

@@ -104,9 +104,20 @@ impl Delaunay {
         mut hit: impl FnMut([VertexId; 4]) -> bool,
     ) -> Option<TetId> {
         scratch.clear();
-        scratch.push(self.mesh.vertex_tet(u)?);
-        // Most stars are small; past a few dozen tets, membership uses a hash set.
-        let mut seen: rustc_hash::FxHashSet<TetId> = rustc_hash::FxHashSet::default();
+        let start = self.mesh.vertex_tet(u)?;
+        let mut visit = self.visit.borrow_mut();
+        let (stamp, walk) = &mut *visit;
+        *walk = walk.wrapping_add(1);
+        if *walk == 0 {
+            stamp.fill(0);
+            *walk = 1;
+        }
+        let walk = *walk;
+        if stamp.len() < self.mesh.num_slots() {
+            stamp.resize(self.mesh.num_slots(), 0);
+        }
+        stamp[start as usize] = walk;
+        scratch.push(start);
         let mut k = 0;
         while k < scratch.len() {
             let t = scratch[k];
@@ -120,15 +131,8 @@ impl Delaunay {
                     continue;
                 }
                 let n = self.mesh.adj(FaceRef::new(t, i)).tet();
-                let new = if scratch.len() < 48 {
-                    !scratch.contains(&n)
-                } else {
-                    if seen.is_empty() {
-                        seen.extend(scratch.iter().copied());
-                    }
-                    seen.insert(n)
-                };
-                if new {
+                if stamp[n as usize] != walk {
+                    stamp[n as usize] = walk;
                     scratch.push(n);
                 }
             }
