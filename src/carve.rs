@@ -16,6 +16,17 @@ pub struct Carved {
     pub attributes: Vec<f64>,
 }
 
+impl Carved {
+    /// Per tet slot (of `slots`), whether the tet is kept.
+    pub fn kept_mask(&self, slots: usize) -> Vec<bool> {
+        let mut kept = vec![false; slots];
+        for &t in &self.tets {
+            kept[t as usize] = true;
+        }
+        kept
+    }
+}
+
 /// Carves the exterior (unless `keep_hull`), then the holes, and floods the regions.
 pub fn carve(cdt: &mut Cdt, holes: &[Point], regions: &[Region], keep_hull: bool) -> Carved {
     let slots = cdt.dt.mesh.num_slots();

@@ -15,7 +15,7 @@ pub mod prepare;
 pub mod segments;
 mod slivers;
 
-use crate::carve::carve;
+use crate::carve::{carve, Carved};
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
 use crate::geom::Point;
@@ -287,12 +287,20 @@ pub fn mesh_plc_with_progress(
             r => r?,
         };
         match outcome {
-            Attempt::Done(cdt, seg_markers) => {
+            Attempt::Done(cdt, seg_markers, carved) => {
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
                 stats.facet_steiner_points = facet_points.len() - free;
                 stats.free_steiner_points += free;
-                let (mesh, more) =
-                    finish(plc, prep, *cdt, &seg_markers, opts, &mut stats, progress)?;
+                let (mesh, more) = finish(
+                    plc,
+                    prep,
+                    *cdt,
+                    carved,
+                    &seg_markers,
+                    opts,
+                    &mut stats,
+                    progress,
+                )?;
                 warnings.extend(more);
                 return Ok(PlcMesh {
                     mesh,
@@ -336,7 +344,12 @@ pub fn mesh_plc_with_progress(
 }
 
 enum Attempt {
-    Done(Box<Cdt>, FxHashMap<(VertexId, VertexId), i32>),
+    /// The CDT, its subsegments' markers, and its carving if one is current.
+    Done(
+        Box<Cdt>,
+        FxHashMap<(VertexId, VertexId), i32>,
+        Option<Carved>,
+    ),
     Restart(Vec<(usize, Point)>, Vec<(usize, f64)>),
 }
 
@@ -593,8 +606,12 @@ fn attempt(
     }
     stats.facet_secs = t2.elapsed().as_secs_f64();
     stats.crossing_tests += cdt.crossing_tests.get();
+    // The carving of the CDT as it stands, while nothing changes it.
+    let mut carved: Option<Carved> = None;
     if steiner.is_empty() && splits.is_empty() {
-        steiner.extend(resolve_shims(&mut cdt, plc, opts));
+        let (more, c) = resolve_shims(&mut cdt, plc, opts);
+        steiner.extend(more);
+        carved = c;
     }
     stats.free_steiner_points = 0;
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
@@ -606,7 +623,7 @@ fn attempt(
         // Free points go straight into the CDT, round after round; only if one cannot
         // (its cavity would cross a constraint) does the construction start again with it.
         for _ in 0..MAX_FREE_ROUNDS {
-            let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain);
+            let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain, &mut carved);
             if debug() && !free.is_empty() {
                 eprintln!("free points {free:?}");
             }
@@ -618,6 +635,7 @@ fn attempt(
             if free.is_empty() {
                 break;
             }
+            carved = None;
             match insert_free(&mut cdt, free, &mut next_pert) {
                 Ok(n) => stats.free_steiner_points += n,
                 Err(_) => {
@@ -631,7 +649,7 @@ fn attempt(
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
-    Ok(Attempt::Done(Box::new(cdt), seg_markers))
+    Ok(Attempt::Done(Box::new(cdt), seg_markers, carved))
 }
 
 /// Inserts free points into the CDT, each with a cavity walled in by the subfaces, and
@@ -794,8 +812,13 @@ fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -
 /// would keep has its two subfaces on the outer side; taking its other two faces as the
 /// polygon's triangles instead puts it outside, where carving removes it. A shim that
 /// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
-/// are returned, and the construction starts again.
-fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Point)> {
+/// are returned, and the construction starts again. Also returns the carving of the CDT
+/// as left, if one was made.
+fn resolve_shims(
+    cdt: &mut Cdt,
+    plc: &Plc,
+    opts: &PlcOptions,
+) -> (Vec<(usize, Point)>, Option<Carved>) {
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
     {
         // A shim has four vertices on one facet: facets of three vertices have none.
@@ -809,13 +832,12 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
             }
         }
     }
-    let mut steiner = Vec::new();
     if facet_verts.is_empty() {
-        return steiner;
+        return (Vec::new(), None);
     }
     for _round in 0..64 {
         let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
-        let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
+        let kept = carved.kept_mask(cdt.dt.mesh.num_slots());
         let mut swapped = false;
         let mut needs: Vec<(usize, Point)> = Vec::new();
         for &t in &carved.tets {
@@ -836,7 +858,7 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
             // The shim can leave the domain only if nothing behind its subfaces is in it.
             let kept_behind_sub = sub.iter().any(|k: &[VertexId; 3]| {
                 let i = (0..4).find(|&i| !k.contains(&v[i])).unwrap_or(0);
-                kept.contains(&cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet())
+                kept[cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet() as usize]
             });
             if debug() {
                 eprintln!(
@@ -883,11 +905,10 @@ fn resolve_shims(cdt: &mut Cdt, plc: &Plc, opts: &PlcOptions) -> Vec<(usize, Poi
         // Swaps can uncover shims stacked behind others: Steiner points are only for
         // what no swap can remove.
         if !swapped {
-            steiner = needs;
-            break;
+            return (needs, Some(carved));
         }
     }
-    steiner
+    (Vec::new(), None)
 }
 
 /// Calls `f` on every edge of the facet's rings and inner segments.
@@ -963,6 +984,7 @@ fn finish(
     plc: &Plc,
     prep: &PreparedPlc,
     mut cdt: Cdt,
+    carved: Option<Carved>,
     seg_markers: &FxHashMap<(VertexId, VertexId), i32>,
     opts: &PlcOptions,
     stats: &mut PlcStats,
@@ -970,7 +992,8 @@ fn finish(
 ) -> Result<(MeshOut, Vec<String>), Error> {
     progress(Stage::Carve);
     let t = Instant::now();
-    let carved = carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull);
+    let carved =
+        carved.unwrap_or_else(|| carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull));
     stats.carve_secs = t.elapsed().as_secs_f64();
     if carved.tets.is_empty() {
         return Err(crate::error::InputError::Invalid {

@@ -8,11 +8,10 @@
 
 use super::cdt::Cdt;
 use super::prepare::PreparedPlc;
-use crate::carve::{carve, containing_tet};
+use crate::carve::{carve, containing_tet, Carved};
 use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, dot, sub, Point};
 use crate::plc::Region;
-use rustc_hash::FxHashSet;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
 /// referee's measure (1e-3) with a margin, so that what we remove is what it flags.
@@ -47,12 +46,13 @@ pub(crate) struct Domain<'a> {
 }
 
 /// Free vertices that remove the flat tets lying on one facet, one per such tet: empty
-/// when there are none.
+/// when there are none. `carved` is the CDT's carving if known, and is set if made.
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     prep: &PreparedPlc,
     input: &[Point],
     domain: &Domain<'_>,
+    carved: &mut Option<Carved>,
 ) -> Vec<Point> {
     // Flat tets are few: find them before building the facets' slabs.
     let flat_tets: Vec<crate::mesh::TetId> = cdt
@@ -129,11 +129,12 @@ pub(crate) fn free_points(
     if flat.is_empty() {
         return Vec::new();
     }
-    let carved = carve(cdt, domain.holes, domain.regions, domain.keep_hull);
-    let kept: FxHashSet<crate::mesh::TetId> = carved.tets.iter().copied().collect();
+    let kept = carved
+        .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
+        .kept_mask(cdt.dt.mesh.num_slots());
     let mut out: Vec<Point> = Vec::new();
     for (t, f) in flat {
-        if !kept.contains(&t) {
+        if !kept[t as usize] {
             continue;
         }
         let Some(slab) = slabs[f as usize].as_ref() else {
@@ -166,7 +167,7 @@ fn is_flat(p: &[Point; 4]) -> bool {
 /// an edge where two facets meet has its sphere off to one side.
 fn remover(
     cdt: &mut Cdt,
-    kept: &FxHashSet<crate::mesh::TetId>,
+    kept: &[bool],
     p: &[Point; 4],
     slab: &Slab,
     slabs: &[Option<Slab>],
@@ -214,7 +215,7 @@ fn remover(
                 if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
                     continue;
                 }
-                if containing_tet(cdt, &w).is_some_and(|t| kept.contains(&t)) {
+                if containing_tet(cdt, &w).is_some_and(|t| kept[t as usize]) {
                     return Some(w);
                 }
             }
