@@ -126,6 +126,9 @@ pub fn insphere(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Point) -> f64 {
     if let Some(sign) = insphere_small_integers(a, b, c_, d, e) {
         return sign;
     }
+    if let Some(sign) = super::fixed::insphere(a, b, c_, d, e) {
+        return -sign as f64;
+    }
     -robust::insphere(c(a), c(b), c(c_), c(d), c(e))
 }
 
