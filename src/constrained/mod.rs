@@ -287,20 +287,11 @@ pub fn mesh_plc_with_progress(
             r => r?,
         };
         match outcome {
-            Attempt::Done(cdt, seg_markers, carved) => {
+            Attempt::Done(built) => {
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
                 stats.facet_steiner_points = facet_points.len() - free;
                 stats.free_steiner_points += free;
-                let (mesh, more) = finish(
-                    plc,
-                    prep,
-                    *cdt,
-                    carved,
-                    &seg_markers,
-                    opts,
-                    &mut stats,
-                    progress,
-                )?;
+                let (mesh, more) = finish(plc, prep, *built, opts, &mut stats, progress)?;
                 warnings.extend(more);
                 return Ok(PlcMesh {
                     mesh,
@@ -343,13 +334,17 @@ pub fn mesh_plc_with_progress(
     }
 }
 
+/// A finished CDT, before carving and output.
+struct Built {
+    cdt: Cdt,
+    /// The subsegments with their markers.
+    seg_markers: FxHashMap<(VertexId, VertexId), i32>,
+    /// The CDT's carving, if one was made since it last changed.
+    carved: Option<Carved>,
+}
+
 enum Attempt {
-    /// The CDT, its subsegments' markers, and its carving if one is current.
-    Done(
-        Box<Cdt>,
-        FxHashMap<(VertexId, VertexId), i32>,
-        Option<Carved>,
-    ),
+    Done(Box<Built>),
     Restart(Vec<(usize, Point)>, Vec<(usize, f64)>),
 }
 
@@ -649,7 +644,11 @@ fn attempt(
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
-    Ok(Attempt::Done(Box::new(cdt), seg_markers, carved))
+    Ok(Attempt::Done(Box::new(Built {
+        cdt,
+        seg_markers,
+        carved,
+    })))
 }
 
 /// Inserts free points into the CDT, each with a cavity walled in by the subfaces, and
@@ -983,14 +982,17 @@ fn regions_of(
 fn finish(
     plc: &Plc,
     prep: &PreparedPlc,
-    mut cdt: Cdt,
-    carved: Option<Carved>,
-    seg_markers: &FxHashMap<(VertexId, VertexId), i32>,
+    built: Built,
     opts: &PlcOptions,
     stats: &mut PlcStats,
     progress: Progress<'_>,
 ) -> Result<(MeshOut, Vec<String>), Error> {
     progress(Stage::Carve);
+    let Built {
+        mut cdt,
+        seg_markers,
+        carved,
+    } = built;
     let t = Instant::now();
     let carved =
         carved.unwrap_or_else(|| carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull));

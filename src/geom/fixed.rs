@@ -68,10 +68,10 @@ impl Add for I320 {
     fn add(self, o: I320) -> I320 {
         let mut out = [0u64; LIMBS];
         let mut carry = false;
-        for i in 0..LIMBS {
-            let (s1, c1) = self.0[i].overflowing_add(o.0[i]);
+        for ((r, &x), &y) in out.iter_mut().zip(&self.0).zip(&o.0) {
+            let (s1, c1) = x.overflowing_add(y);
             let (s2, c2) = s1.overflowing_add(carry as u64);
-            out[i] = s2;
+            *r = s2;
             carry = c1 || c2;
         }
         I320(out)
@@ -81,7 +81,15 @@ impl Add for I320 {
 impl Sub for I320 {
     type Output = I320;
     fn sub(self, o: I320) -> I320 {
-        self + o.neg()
+        let mut out = [0u64; LIMBS];
+        let mut borrow = false;
+        for ((r, &x), &y) in out.iter_mut().zip(&self.0).zip(&o.0) {
+            let (d1, b1) = x.overflowing_sub(y);
+            let (d2, b2) = d1.overflowing_sub(borrow as u64);
+            *r = d2;
+            borrow = b1 || b2;
+        }
+        I320(out)
     }
 }
 
