@@ -88,17 +88,32 @@ pub fn recover_segments(
         }
     }
     // The pieces that are edges at the start, found in one pass over the tets (a walk
-    // around each would cost much more).
+    // around each would cost much more). Each vertex lists its pieces' other ends, most
+    // vertices have none or a few: cheaper than hashing every edge of every tet.
     let present: rustc_hash::FxHashSet<(VertexId, VertexId)> = {
-        let wanted: rustc_hash::FxHashSet<(VertexId, VertexId)> =
-            queue.iter().map(|pc| edge_key(pc.u, pc.v)).collect();
+        let n = dt.points.len();
+        let mut first = vec![0u32; n + 1];
+        for pc in &queue {
+            first[pc.u.min(pc.v) as usize + 1] += 1;
+        }
+        for i in 0..n {
+            first[i + 1] += first[i];
+        }
+        let mut other = vec![0 as VertexId; queue.len()];
+        let mut fill = first.clone();
+        for pc in &queue {
+            let lo = pc.u.min(pc.v) as usize;
+            other[fill[lo] as usize] = pc.u.max(pc.v);
+            fill[lo] += 1;
+        }
         let mut present = rustc_hash::FxHashSet::default();
         for t in dt.mesh.real_tets() {
             let v = dt.mesh.verts(t);
             for (i, j) in EDGE_VERTS {
-                let k = edge_key(v[i], v[j]);
-                if wanted.contains(&k) {
-                    present.insert(k);
+                let (a, b) = edge_key(v[i], v[j]);
+                let list = &other[first[a as usize] as usize..first[a as usize + 1] as usize];
+                if list.contains(&b) {
+                    present.insert((a, b));
                 }
             }
         }
@@ -182,8 +197,11 @@ pub fn recover_segments(
                 v: pc.v,
             });
         }
-        // A last full check, in case a piece was lost without a recorded cavity.
-        done.recheck_all(dt, &mut queue);
+        // A last full check, in case a piece was lost without a recorded cavity (none
+        // can be if nothing was inserted).
+        if steiner > 0 {
+            done.recheck_all(dt, &mut queue);
+        }
         if queue.is_empty() {
             break;
         }
@@ -206,19 +224,22 @@ pub fn recover_segments(
     })
 }
 
-/// The pieces recovered so far, with the pieces at each vertex.
+/// The pieces recovered so far, with the pieces at each vertex (indexed from the first
+/// [`Recovered::recheck`] on: most segments need no Steiner point, and then no index).
 #[derive(Default)]
 struct Recovered {
     pieces: Vec<Option<Piece>>,
-    at: rustc_hash::FxHashMap<VertexId, Vec<usize>>,
+    at: Option<rustc_hash::FxHashMap<VertexId, Vec<usize>>>,
 }
 
 impl Recovered {
     fn push(&mut self, pc: Piece) {
         let i = self.pieces.len();
         self.pieces.push(Some(pc));
-        self.at.entry(pc.u).or_default().push(i);
-        self.at.entry(pc.v).or_default().push(i);
+        if let Some(at) = &mut self.at {
+            at.entry(pc.u).or_default().push(i);
+            at.entry(pc.v).or_default().push(i);
+        }
     }
 
     /// Sends back to `queue` the pieces between two `cavity` vertices that are no
@@ -231,11 +252,21 @@ impl Recovered {
         queue: &mut Vec<Piece>,
         scratch: &mut Vec<crate::mesh::TetId>,
     ) {
+        let at = self.at.get_or_insert_with(|| {
+            let mut at: rustc_hash::FxHashMap<VertexId, Vec<usize>> = Default::default();
+            for (i, pc) in self.pieces.iter().enumerate() {
+                if let Some(pc) = pc {
+                    at.entry(pc.u).or_default().push(i);
+                    at.entry(pc.v).or_default().push(i);
+                }
+            }
+            at
+        });
         for &x in cavity {
             if x == new {
                 continue;
             }
-            let Some(list) = self.at.get_mut(&x) else {
+            let Some(list) = at.get_mut(&x) else {
                 continue;
             };
             list.retain(|&i| self.pieces[i].is_some());
