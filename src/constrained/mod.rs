@@ -207,14 +207,30 @@ pub fn mesh_plc_with_progress(
     opts: &PlcOptions,
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
-    let base = prepare(plc, opts.merge)?;
-    // Flat tets are judged on the facets as merged by default, whatever the switches and
-    // the splitting of groups below did.
-    let all_merged = if opts.merge {
-        None
-    } else {
-        Some(prepare(plc, true)?)
-    };
+    // The PLC's preparation and the first attempt's Delaunay tetrahedralization do not
+    // depend on each other: they run on two cores.
+    progress(Stage::Delaunay);
+    let (prepared, first_dt) = std::thread::scope(|s| {
+        let preparing = s.spawn(|| -> Result<_, Error> {
+            let base = prepare(plc, opts.merge)?;
+            // Flat tets are judged on the facets as merged by default, whatever the
+            // switches and the splitting of groups below did.
+            let all_merged = if opts.merge {
+                None
+            } else {
+                Some(prepare(plc, true)?)
+            };
+            Ok((base, all_merged))
+        });
+        let t0 = Instant::now();
+        let dt = Delaunay::build(&plc.points).map(|b| (b.dt, t0.elapsed().as_secs_f64()));
+        let prepared = preparing
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (prepared, dt)
+    });
+    let (base, all_merged) = prepared?;
+    let mut first_dt = Some(first_dt?);
     let merged = all_merged.as_ref().unwrap_or(&base);
     // `base` with the groups that could not be triangulated in one plane kept apart.
     let mut split: Option<PreparedPlc> = None;
@@ -257,6 +273,7 @@ pub fn mesh_plc_with_progress(
         let prep = split.as_ref().unwrap_or(&base);
         let outcome = match attempt(
             plc,
+            first_dt.take(),
             [prep, merged],
             &facet_points,
             &presplits,
@@ -352,6 +369,7 @@ enum Attempt {
 /// meshed, `merged` with every coplanar group merged (for [`slivers`]).
 fn attempt(
     plc: &Plc,
+    built: Option<(Delaunay, f64)>,
     [prep, merged]: [&PreparedPlc; 2],
     facet_points: &[(usize, Point)],
     presplits: &[(usize, f64)],
@@ -363,10 +381,20 @@ fn attempt(
     let mut points = plc.points.clone();
     points.extend(facet_points.iter().map(|&(_, p)| p));
     // Duplicated input points go to their representative; only those are meshed.
-    progress(Stage::Delaunay);
-    let t0 = Instant::now();
-    let mut dt = Delaunay::build(&points)?.dt;
-    stats.delaunay_secs = t0.elapsed().as_secs_f64();
+    let mut dt = match built {
+        // Built beforehand, of the input points only.
+        Some((dt, secs)) if facet_points.is_empty() => {
+            stats.delaunay_secs = secs;
+            dt
+        }
+        _ => {
+            progress(Stage::Delaunay);
+            let t0 = Instant::now();
+            let dt = Delaunay::build(&points)?.dt;
+            stats.delaunay_secs = t0.elapsed().as_secs_f64();
+            dt
+        }
+    };
 
     progress(Stage::Segments);
     let t1 = Instant::now();
