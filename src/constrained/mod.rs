@@ -275,8 +275,7 @@ pub fn mesh_plc_with_progress(
             plc,
             first_dt.take(),
             [prep, merged],
-            &facet_points,
-            &presplits,
+            (&facet_points, &presplits),
             opts,
             &mut stats,
             progress,
@@ -360,9 +359,14 @@ struct Built {
     carved: Option<Carved>,
 }
 
+/// A Steiner point found by an earlier attempt: (merged facet or [`FREE_POINT`], point).
+type FacetPoint = (usize, Point);
+/// A split asked for by an earlier attempt: (segment, parameter along it).
+type SegmentSplit = (usize, f64);
+
 enum Attempt {
     Done(Box<Built>),
-    Restart(Vec<(usize, Point)>, Vec<(usize, f64)>),
+    Restart(Vec<FacetPoint>, Vec<SegmentSplit>),
 }
 
 /// One construction from scratch: Delaunay, segments, facets. `prep` is the PLC as
@@ -371,8 +375,7 @@ fn attempt(
     plc: &Plc,
     built: Option<(Delaunay, f64)>,
     [prep, merged]: [&PreparedPlc; 2],
-    facet_points: &[(usize, Point)],
-    presplits: &[(usize, f64)],
+    (facet_points, presplits): (&[FacetPoint], &[SegmentSplit]),
     opts: &PlcOptions,
     stats: &mut PlcStats,
     progress: Progress<'_>,

@@ -276,8 +276,8 @@ pub fn write_files(
 
 /// [`write_files`], taking the `.node` file from `early` (see [`write_node_early`]) if
 /// it holds the mesh's nodes.
-pub fn write_files_with(
-    mesh: &MeshOut,
+pub fn write_files_with<'m>(
+    mesh: &'m MeshOut,
     prefix: &Path,
     w: &WriteOptions,
     on_file: &mut dyn FnMut(&Path),
@@ -289,37 +289,53 @@ pub fn write_files_with(
     let mut temps: Vec<PathBuf> = Vec::with_capacity(kinds.len());
     let mut renamed = 0;
     let result = (|| -> Result<(), Error> {
-        // Derived at most once, shared by the .face/.edge/.neigh writers, and only if
-        // one of them needs it: deriving neighbours sorts every face of the mesh.
-        let derived = OnceCell::new();
-        for (&kind, fin) in kinds.iter().zip(&finals) {
+        for fin in &finals {
             on_file(fin);
-            let tmp = temp_path(fin);
-            temps.push(tmp.clone());
-            if kind == FileKind::Node {
-                if let Some(e) = early.as_mut() {
-                    // From here on the temporary is ours to rename or remove.
-                    e.kept = true;
-                    continue;
-                }
-            }
+            temps.push(temp_path(fin));
+        }
+        let write_one = |i: usize, derived: &OnceCell<Derived<'m>>| -> Result<(), Error> {
+            let (kind, fin, tmp) = (kinds[i], &finals[i], &temps[i]);
             let out_err = |source| Error::Output {
                 file: fin.clone(),
                 source,
             };
             if matches!(kind, FileKind::Node | FileKind::Ele) {
-                // The big ones.
-                let mut file = OutFile::create(&tmp).map_err(out_err)?;
-                write_kind_with(&mut file, kind, mesh, w, &derived).map_err(out_err)?;
-                file.finish().map_err(out_err)?;
-                continue;
+                let mut file = OutFile::create(tmp).map_err(out_err)?;
+                write_kind_with(&mut file, kind, mesh, w, derived).map_err(out_err)?;
+                return file.finish().map_err(out_err);
             }
-            let file = File::create(&tmp).map_err(out_err)?;
+            let file = File::create(tmp).map_err(out_err)?;
             let mut bw = BufWriter::with_capacity(1 << 16, file);
-            write_kind_with(&mut bw, kind, mesh, w, &derived).map_err(out_err)?;
-            let file = bw.into_inner().map_err(|e| out_err(e.into_error()))?;
-            drop(file);
-        }
+            write_kind_with(&mut bw, kind, mesh, w, derived).map_err(out_err)?;
+            bw.into_inner().map_err(|e| out_err(e.into_error()))?;
+            Ok(())
+        };
+        // The .node file written early is already in its temporary: ours to rename or
+        // remove from here on.
+        let skip_node = match early.as_mut() {
+            Some(e) => {
+                e.kept = true;
+                true
+            }
+            None => false,
+        };
+        let (big, small): (Vec<usize>, Vec<usize>) = (0..kinds.len())
+            .filter(|&i| !(skip_node && kinds[i] == FileKind::Node))
+            .partition(|&i| matches!(kinds[i], FileKind::Node | FileKind::Ele));
+        // The big files go on a second core while the others are written here, with
+        // what they derive (neighbours) computed at most once.
+        std::thread::scope(|s| {
+            let writer = s.spawn(|| {
+                let none = OnceCell::new();
+                big.iter().try_for_each(|&i| write_one(i, &none))
+            });
+            let derived = OnceCell::new();
+            let here = small.iter().try_for_each(|&i| write_one(i, &derived));
+            let there = writer
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            there.and(here)
+        })?;
         // A directory in the way would make its rename fail after others succeeded.
         for fin in &finals {
             if fin.is_dir() {
