@@ -648,8 +648,11 @@ fn attempt(
         };
         // Free points go straight into the CDT, round after round; only if one cannot
         // (its cavity would cross a constraint) does the construction start again with it.
+        let mut stuck = Vec::new();
         for _ in 0..MAX_FREE_ROUNDS {
-            let free = slivers::free_points(&mut cdt, merged, &plc.points, &domain, &mut carved);
+            let found = slivers::free_points(&mut cdt, merged, &plc.points, &domain, &mut carved);
+            let free = found.points;
+            stuck = found.stuck;
             if debug() && !free.is_empty() {
                 eprintln!("free points {free:?}");
             }
@@ -671,6 +674,20 @@ fn attempt(
             }
         }
         stats.steiner_points += stats.free_steiner_points;
+        // A flat tet whose circumsphere lies within its facet's slab spans a gap between
+        // segments closer than the slab is thick. Its size, not its shape, makes it flat:
+        // splitting its longest subsegment makes the tets there smaller against the gap.
+        // Like free points, they only improve a valid CDT: only while the restart they
+        // cost stays well within the bounds on restarts and their work.
+        let affordable = stats.restarts + 1 < MAX_FREE_ROUNDS
+            && stats.crossing_tests < RESTART_WORK / 4
+            && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
+        if steiner.is_empty() && affordable {
+            splits.extend(flat_tet_splits(&cdt, &stuck, &seg_of, &subsegs));
+            if debug() && !splits.is_empty() {
+                eprintln!("flat tets {stuck:?}: splits {splits:?}");
+            }
+        }
     }
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
@@ -680,6 +697,36 @@ fn attempt(
         seg_markers,
         carved,
     })))
+}
+
+/// For each flat tet, the split of its longest edge that is a subsegment, as (segment,
+/// parameter along it).
+fn flat_tet_splits(
+    cdt: &Cdt,
+    stuck: &[[VertexId; 4]],
+    seg_of: &FxHashMap<(VertexId, VertexId), usize>,
+    subsegs: &segments::Subsegments,
+) -> Vec<(usize, f64)> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    let mut split: FxHashSet<(VertexId, VertexId)> = FxHashSet::default();
+    for v in stuck {
+        let len2 = |&(a, b): &(VertexId, VertexId)| {
+            let d = crate::geom::sub(&cdt.dt.points[a as usize], &cdt.dt.points[b as usize]);
+            crate::geom::dot(&d, &d)
+        };
+        let longest = crate::mesh::EDGE_VERTS
+            .iter()
+            .map(|&(i, j)| edge_key(v[i], v[j]))
+            .filter(|e| seg_of.contains_key(e))
+            .max_by(|x, y| len2(x).total_cmp(&len2(y)));
+        if let Some(e) = longest {
+            if split.insert(e) {
+                let seg = seg_of[&e];
+                out.push((seg, midpoint_parameter(cdt, &subsegs.chains[seg], e.0, e.1)));
+            }
+        }
+    }
+    out
 }
 
 /// Inserts free points into the CDT, each with a cavity walled in by the subfaces, and

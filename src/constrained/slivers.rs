@@ -45,15 +45,26 @@ pub(crate) struct Domain<'a> {
     pub keep_hull: bool,
 }
 
-/// Free vertices that remove the flat tets lying on one facet, one per such tet: empty
-/// when there are none. `carved` is the CDT's carving if known, and is set if made.
+/// What [`free_points`] found.
+#[derive(Default)]
+pub(crate) struct FlatTets {
+    /// Free vertices that remove flat tets, one per tet.
+    pub points: Vec<Point>,
+    /// The kept flat tets for which no free vertex was found (their circumspheres lie
+    /// within the facet's slab), by their vertices.
+    pub stuck: Vec<[crate::mesh::VertexId; 4]>,
+}
+
+/// Free vertices that remove the flat tets lying on one facet, one per such tet, and
+/// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
+/// if made.
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     prep: &PreparedPlc,
     input: &[Point],
     domain: &Domain<'_>,
     carved: &mut Option<Carved>,
-) -> Vec<Point> {
+) -> FlatTets {
     // Flat tets are few: find them before building the facets' slabs.
     let flat_tets: Vec<crate::mesh::TetId> = cdt
         .dt
@@ -63,7 +74,7 @@ pub(crate) fn free_points(
         .filter(|&t| is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize])))
         .collect();
     if flat_tets.is_empty() {
-        return Vec::new();
+        return FlatTets::default();
     }
     let n_input = input.len();
     let diag = diagonal(input);
@@ -127,12 +138,12 @@ pub(crate) fn free_points(
         }
     }
     if flat.is_empty() {
-        return Vec::new();
+        return FlatTets::default();
     }
     let kept = carved
         .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
         .kept_mask(cdt.dt.mesh.num_slots());
-    let mut out: Vec<Point> = Vec::new();
+    let mut out = FlatTets::default();
     for (t, f) in flat {
         if !kept[t as usize] {
             continue;
@@ -141,10 +152,13 @@ pub(crate) fn free_points(
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        if let Some(w) = remover(cdt, &kept, &p, slab, &slabs) {
-            if !out.contains(&w) {
-                out.push(w);
+        match remover(cdt, &kept, &p, slab, &slabs) {
+            Some(w) => {
+                if !out.points.contains(&w) {
+                    out.points.push(w);
+                }
             }
+            None => out.stuck.push(cdt.dt.mesh.verts(t)),
         }
     }
     out
