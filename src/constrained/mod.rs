@@ -209,10 +209,20 @@ pub fn mesh_plc_with_progress(
 ) -> Result<PlcMesh, Error> {
     // The PLC's preparation and the first attempt's Delaunay tetrahedralization do not
     // depend on each other: they run on two cores.
+    // An open surface is found once prepared: the Delaunay stage then stops early.
     progress(Stage::Delaunay);
+    let open = AtomicBool::new(false);
     let (prepared, first_dt) = std::thread::scope(|s| {
         let preparing = s.spawn(|| -> Result<_, Error> {
-            let base = prepare(plc, opts.merge)?;
+            let base = prepare(plc, opts.merge);
+            let refused = match &base {
+                Ok(b) => !opts.keep_hull && enclosure::open_boundary(plc, b).is_some(),
+                Err(_) => true,
+            };
+            if refused {
+                open.store(true, Ordering::Relaxed);
+            }
+            let base = base?;
             // Flat tets are judged on the facets as merged by default, whatever the
             // switches and the splitting of groups below did.
             let all_merged = if opts.merge {
@@ -223,26 +233,27 @@ pub fn mesh_plc_with_progress(
             Ok((base, all_merged))
         });
         let t0 = Instant::now();
-        let dt = Delaunay::build(&plc.points).map(|b| (b.dt, t0.elapsed().as_secs_f64()));
+        let dt =
+            Delaunay::build_until(&plc.points, &open).map(|b| (b.dt, t0.elapsed().as_secs_f64()));
         let prepared = preparing
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (prepared, dt)
     });
     let (base, all_merged) = prepared?;
-    let mut first_dt = Some(first_dt?);
     let merged = all_merged.as_ref().unwrap_or(&base);
     // `base` with the groups that could not be triangulated in one plane kept apart.
     let mut split: Option<PreparedPlc> = None;
     let prep = &base;
     // The message lists the boundary edges in the input's own terms.
-    if !opts.keep_hull && enclosure::open_boundary(plc, prep).is_some() {
+    if open.load(Ordering::Relaxed) {
         return Err(crate::error::InputError::Invalid {
             file: plc.source.clone(),
             msg: crate::precheck::empty_domain_message(plc),
         }
         .into());
     }
+    let mut first_dt = Some(first_dt?);
     // Input facets kept out of merging because their merged group could not be
     // triangulated in one plane.
     let mut keep_apart: Vec<usize> = Vec::new();

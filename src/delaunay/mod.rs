@@ -72,6 +72,15 @@ pub struct Built {
 impl Delaunay {
     /// Builds the Delaunay tetrahedralization of `points` (BRIO + Hilbert insertion order).
     pub fn build(points: &[Point]) -> Result<Built, MeshError> {
+        Self::build_until(points, &std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// [`Delaunay::build`], giving up (with a failure whose reason is never shown) once
+    /// `stop` is set by another thread that found the run pointless.
+    pub fn build_until(
+        points: &[Point],
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<Built, MeshError> {
         if let Some((i, _)) = points
             .iter()
             .enumerate()
@@ -113,6 +122,9 @@ impl Delaunay {
         for v in 0..n as u32 {
             if first.contains(&v) {
                 continue;
+            }
+            if v % 4096 == 0 && stop.load(std::sync::atomic::Ordering::Relaxed) {
+                return Err(MeshError::Failed("stopped".into()));
             }
             dt.insert(v)?;
         }
