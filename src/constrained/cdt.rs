@@ -67,10 +67,10 @@ impl Cdt {
         self.face_index = self.dt.mesh.face_index();
     }
 
-    /// Like [`Cdt::index_faces`], for the faces whose vertices are all marked in `keep`
-    /// (the vertices of facets: only their faces are looked up).
-    pub fn index_faces_among(&mut self, keep: &[bool]) {
-        self.face_index = self.dt.mesh.face_index_among(Some(keep));
+    /// Like [`Cdt::index_faces`], for the faces among `wanted` (sorted keys): the only
+    /// ones [`Cdt::has_face`] will be asked about, such as the facets' triangles.
+    pub fn index_faces_of(&mut self, wanted: &[[VertexId; 3]]) {
+        self.face_index = self.dt.mesh.face_index_of(self.dt.points.len(), wanted);
     }
 
     /// True if `(a, b, c)` is a face of the mesh.

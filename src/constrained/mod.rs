@@ -429,29 +429,6 @@ fn attempt(
     progress(Stage::Facets);
     let t2 = Instant::now();
     let inv = dt.internal_ids(points.len());
-    // Only triangles of facets are looked up: index the faces among facet vertices.
-    let mut on_facet = vec![false; dt.points.len()];
-    let mut mark = |v: u32| {
-        if let Some(m) = on_facet.get_mut(v as usize) {
-            *m = true;
-        }
-    };
-    for f in &prep.facets {
-        let inner = f.inner_segments.iter().flatten();
-        for &v in f.rings.iter().flatten().chain(inner).chain(&f.isolated) {
-            mark(inv[v as usize]);
-        }
-    }
-    for &v in subsegs.chains.iter().flatten() {
-        mark(v);
-    }
-    for (k, &(f, _)) in facet_points.iter().enumerate() {
-        if f != FREE_POINT {
-            mark(inv[n_input + k]);
-        }
-    }
-    let mut cdt = Cdt::new(dt);
-    cdt.index_faces_among(&on_facet);
     let seg_index: FxHashMap<(u32, u32), usize> = prep
         .segments
         .iter()
@@ -475,9 +452,6 @@ fn attempt(
             seg_of.insert(edge_key(w[0], w[1]), i);
         }
     }
-    let mut splits: Vec<(usize, f64)> = Vec::new();
-    cdt.subsegs = seg_markers.clone();
-
     let mut extra: Vec<Vec<VertexId>> = vec![Vec::new(); prep.facets.len()];
     for (k, &(f, _)) in facet_points.iter().enumerate() {
         let v = inv[n_input + k];
@@ -485,6 +459,29 @@ fn attempt(
             extra[f].push(v);
         }
     }
+    // Each facet's triangles depend only on its vertices and subsegments, not on the
+    // tets: all are computed up front, on two cores, and only they are indexed for the
+    // lookups of the mesh faces.
+    let ctx = FacetContext {
+        plc,
+        prep,
+        points: &dt.points,
+        orig: &dt.orig,
+        inv: &inv,
+        seg_index: &seg_index,
+        subsegs: &subsegs,
+        extra: &extra,
+    };
+    let mut facet_tris = ctx.triangulate_all();
+    let wanted: Vec<[VertexId; 3]> = facet_tris
+        .iter()
+        .flat_map(|r| r.as_ref().ok().into_iter().flatten().flatten())
+        .map(|t| face_key(*t))
+        .collect();
+    let mut cdt = Cdt::new(dt);
+    cdt.index_faces_of(&wanted);
+    let mut splits: Vec<(usize, f64)> = Vec::new();
+    cdt.subsegs = seg_markers.clone();
     let mut queue: Vec<usize> = (0..prep.facets.len()).collect();
     queue.reverse();
     let mut queued: FxHashSet<usize> = queue.iter().copied().collect();
@@ -503,93 +500,16 @@ fn attempt(
             continue;
         }
         let f = &prep.facets[fi];
-        let mut verts: Vec<VertexId> = Vec::new();
-        let mut constraints: Vec<[VertexId; 2]> = Vec::new();
-        let add_edge =
-            |a: u32, b: u32, verts: &mut Vec<VertexId>, cons: &mut Vec<[VertexId; 2]>| {
-                match seg_index.get(&(a.min(b), a.max(b))) {
-                    Some(&si) => {
-                        let chain = &subsegs.chains[si];
-                        verts.extend_from_slice(chain);
-                        cons.extend(chain.windows(2).map(|w| [w[0], w[1]]));
-                    }
-                    None => {
-                        verts.push(inv[a as usize]);
-                        verts.push(inv[b as usize]);
-                    }
-                }
-            };
-        for_each_edge(f, |a, b| add_edge(a, b, &mut verts, &mut constraints));
-        for &v in &f.isolated {
-            verts.push(inv[v as usize]);
-        }
-        verts.extend_from_slice(&extra[fi]);
-        if verts.contains(&u32::MAX) {
-            return Err(MeshError::Internal(format!(
-                "facet {fi} has a vertex missing from the mesh"
-            ))
-            .into());
-        }
-        verts.sort_unstable();
-        verts.dedup();
-        if f.rings.is_empty() {
-            continue;
-        }
-        // Most facets of surface meshes are single triangles: no 2D CDT for them.
-        let single = match (&f.rings[..], verts.len()) {
-            ([ring], 3) if f.holes.is_empty() && f.source_facets.len() == 1 && ring.len() == 3 => {
-                facet2d::single_triangle(&cdt.dt.points, [0, 1, 2].map(|k| verts[k]), f.normal)
-            }
-            _ => None,
-        };
-        let mut tris = match single {
-            Some(t) => Ok(vec![t]),
-            None => facet2d::triangulate_facet(
-                &cdt.dt.points,
-                &cdt.dt.orig,
-                &verts,
-                &constraints,
-                &f.holes,
-                f.normal,
-            ),
-        }
-        .map_err(|e| {
-            if debug() {
-                eprintln!(
-                    "facet {fi}: sources {:?} rings {:?}",
-                    f.source_facets, f.rings
-                );
-                let o: Vec<(u32, u32)> = constraints
-                    .iter()
-                    .map(|c| (cdt.dt.orig[c[0] as usize], cdt.dt.orig[c[1] as usize]))
-                    .collect();
-                eprintln!("  constraints (output ids) {o:?}");
-            }
-            if f.source_facets.len() > 1 {
-                let list: Vec<String> = f.source_facets.iter().map(|s| s.to_string()).collect();
-                MeshError::Failed(format!(
-                    "{UNFLAT_GROUP}{}: facet {}: {e}",
-                    list.join(","),
-                    facet_name(plc, f)
+        let tris = match &mut facet_tris[fi] {
+            Ok(Some(tris)) => tris.clone(),
+            Ok(None) => continue,
+            Err(e) => {
+                return Err(std::mem::replace(
+                    e,
+                    MeshError::Failed(String::new()).into(),
                 ))
-            } else {
-                MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f)))
             }
-        })?;
-        // A merged facet covers only its polygons: keep the triangles reachable from the
-        // inner side of its polygons' edges without crossing a subsegment (gaps that the
-        // polygons enclose without covering are not reachable from the hull's flood).
-        if f.source_facets.len() > 1 {
-            tris = inside_polygons(
-                &cdt.dt.points,
-                &tris,
-                f,
-                &inv,
-                &seg_index,
-                &subsegs,
-                &constraints,
-            );
-        }
+        };
         let mut missing = Vec::new();
         for t in &tris {
             if cdt.has_face(t[0], t[1], t[2]) {
@@ -884,6 +804,147 @@ fn inside_polygons(
         .filter(|(_, k)| *k)
         .map(|(t, _)| *t)
         .collect()
+}
+
+/// What the triangulation of each facet needs: the facets, the vertices (internal ids
+/// via `inv`), the subsegment chains and the Steiner points on facets.
+struct FacetContext<'a> {
+    plc: &'a Plc,
+    prep: &'a PreparedPlc,
+    points: &'a [Point],
+    orig: &'a [u32],
+    inv: &'a [VertexId],
+    seg_index: &'a FxHashMap<(u32, u32), usize>,
+    subsegs: &'a segments::Subsegments,
+    extra: &'a [Vec<VertexId>],
+}
+
+/// A facet's triangles (`None` for a facet without rings), or why it has none.
+type FacetTris = Result<Option<Vec<[VertexId; 3]>>, Error>;
+
+impl FacetContext<'_> {
+    /// Every facet's triangles, the facets split in two halves of about equal work, one
+    /// on a second core.
+    fn triangulate_all(&self) -> Vec<FacetTris> {
+        let facets = &self.prep.facets;
+        let work: Vec<usize> = facets
+            .iter()
+            .map(|f| f.rings.iter().map(|r| r.len()).sum::<usize>() + f.isolated.len() + 1)
+            .collect();
+        let total: usize = work.iter().sum();
+        let mut acc = 0;
+        let half = work
+            .iter()
+            .position(|w| {
+                acc += w;
+                2 * acc >= total
+            })
+            .map_or(facets.len(), |i| i + 1);
+        std::thread::scope(|s| {
+            let second = s.spawn(|| (half..facets.len()).map(|fi| self.triangles(fi)).collect());
+            let mut all: Vec<FacetTris> = (0..half).map(|fi| self.triangles(fi)).collect();
+            let rest: Vec<FacetTris> = second
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            all.extend(rest);
+            all
+        })
+    }
+
+    /// The triangles of facet `fi`: its 2D CDT with its subsegments, restricted to its
+    /// polygons.
+    fn triangles(&self, fi: usize) -> FacetTris {
+        let (plc, inv, seg_index, subsegs) = (self.plc, self.inv, self.seg_index, self.subsegs);
+        let f = &self.prep.facets[fi];
+        let mut verts: Vec<VertexId> = Vec::new();
+        let mut constraints: Vec<[VertexId; 2]> = Vec::new();
+        let add_edge =
+            |a: u32, b: u32, verts: &mut Vec<VertexId>, cons: &mut Vec<[VertexId; 2]>| {
+                match seg_index.get(&(a.min(b), a.max(b))) {
+                    Some(&si) => {
+                        let chain = &subsegs.chains[si];
+                        verts.extend_from_slice(chain);
+                        cons.extend(chain.windows(2).map(|w| [w[0], w[1]]));
+                    }
+                    None => {
+                        verts.push(inv[a as usize]);
+                        verts.push(inv[b as usize]);
+                    }
+                }
+            };
+        for_each_edge(f, |a, b| add_edge(a, b, &mut verts, &mut constraints));
+        for &v in &f.isolated {
+            verts.push(inv[v as usize]);
+        }
+        verts.extend_from_slice(&self.extra[fi]);
+        if verts.contains(&u32::MAX) {
+            return Err(MeshError::Internal(format!(
+                "facet {fi} has a vertex missing from the mesh"
+            ))
+            .into());
+        }
+        verts.sort_unstable();
+        verts.dedup();
+        if f.rings.is_empty() {
+            return Ok(None);
+        }
+        // Most facets of surface meshes are single triangles: no 2D CDT for them.
+        let single = match (&f.rings[..], verts.len()) {
+            ([ring], 3) if f.holes.is_empty() && f.source_facets.len() == 1 && ring.len() == 3 => {
+                facet2d::single_triangle(self.points, [0, 1, 2].map(|k| verts[k]), f.normal)
+            }
+            _ => None,
+        };
+        let tris = match single {
+            Some(t) => Ok(vec![t]),
+            None => facet2d::triangulate_facet(
+                self.points,
+                self.orig,
+                &verts,
+                &constraints,
+                &f.holes,
+                f.normal,
+            ),
+        }
+        .map_err(|e| {
+            if debug() {
+                eprintln!(
+                    "facet {fi}: sources {:?} rings {:?}",
+                    f.source_facets, f.rings
+                );
+                let o: Vec<(u32, u32)> = constraints
+                    .iter()
+                    .map(|c| (self.orig[c[0] as usize], self.orig[c[1] as usize]))
+                    .collect();
+                eprintln!("  constraints (output ids) {o:?}");
+            }
+            if f.source_facets.len() > 1 {
+                let list: Vec<String> = f.source_facets.iter().map(|s| s.to_string()).collect();
+                MeshError::Failed(format!(
+                    "{UNFLAT_GROUP}{}: facet {}: {e}",
+                    list.join(","),
+                    facet_name(plc, f)
+                ))
+            } else {
+                MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f)))
+            }
+        })?;
+        // A merged facet covers only its polygons: keep the triangles reachable from the
+        // inner side of its polygons' edges without crossing a subsegment (gaps that the
+        // polygons enclose without covering are not reachable from the hull's flood).
+        if f.source_facets.len() > 1 {
+            return Ok(Some(inside_polygons(
+                self.points,
+                &tris,
+                f,
+                inv,
+                seg_index,
+                subsegs,
+                &constraints,
+            )));
+        }
+        Ok(Some(tris))
+    }
 }
 
 /// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.

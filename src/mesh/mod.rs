@@ -257,24 +257,10 @@ impl Mesh {
     /// Every face of the real tets, keyed by its sorted vertices, with one tet side of
     /// it: constant-time face lookups for as long as the mesh does not change.
     pub fn face_index(&self) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
-        self.face_index_among(None)
-    }
-
-    /// [`Mesh::face_index`] restricted to faces whose three vertices are all marked in
-    /// `keep` (all faces for `None`).
-    pub fn face_index_among(
-        &self,
-        keep: Option<&[bool]>,
-    ) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
         let mut index = rustc_hash::FxHashMap::default();
-        let kept = |x: VertexId| keep.is_none_or(|k| k.get(x as usize).copied().unwrap_or(false));
         for t in self.real_tets() {
             let v = self.verts(t);
-            let marked = [kept(v[0]), kept(v[1]), kept(v[2]), kept(v[3])];
             for (i, fv) in FACE_VERTS.iter().enumerate() {
-                if !fv.iter().all(|&j| marked[j]) {
-                    continue;
-                }
                 // Each face once: from the lower of its two real tets.
                 let n = self.adj(FaceRef::new(t, i)).tet();
                 if n < t && self.verts(n)[3] != GHOST {
@@ -283,6 +269,46 @@ impl Mesh {
                 let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
                 k.sort_unstable();
                 index.insert(k, FaceRef::new(t, i));
+            }
+        }
+        index
+    }
+
+    /// [`Mesh::face_index`] restricted to the faces among `wanted` (sorted vertex keys,
+    /// vertex ids below `num_vertices`). One pass over the tets, where each face is
+    /// compared with the few wanted faces at its lowest vertex: no hashing of every face.
+    pub fn face_index_of(
+        &self,
+        num_vertices: usize,
+        wanted: &[[VertexId; 3]],
+    ) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
+        let mut first = vec![0u32; num_vertices + 1];
+        for k in wanted.iter().filter(|k| (k[2] as usize) < num_vertices) {
+            first[k[0] as usize + 1] += 1;
+        }
+        for i in 0..num_vertices {
+            first[i + 1] += first[i];
+        }
+        let mut rest = vec![[0 as VertexId; 2]; first[num_vertices] as usize];
+        let mut fill = first.clone();
+        for k in wanted.iter().filter(|k| (k[2] as usize) < num_vertices) {
+            rest[fill[k[0] as usize] as usize] = [k[1], k[2]];
+            fill[k[0] as usize] += 1;
+        }
+        let mut index = rustc_hash::FxHashMap::default();
+        index.reserve(wanted.len());
+        for t in self.real_tets() {
+            let v = self.verts(t);
+            for (i, fv) in FACE_VERTS.iter().enumerate() {
+                let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
+                k.sort_unstable();
+                let at = k[0] as usize;
+                if at >= num_vertices || first[at] == first[at + 1] {
+                    continue;
+                }
+                if rest[first[at] as usize..first[at + 1] as usize].contains(&[k[1], k[2]]) {
+                    index.insert(k, FaceRef::new(t, i));
+                }
             }
         }
         index
