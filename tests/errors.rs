@@ -259,6 +259,15 @@ fn duplicate_facet_exits_3() {
 }
 
 #[test]
+fn duplicate_triangle_exits_3() {
+    // The last triangle repeats the second one, rotated and reversed.
+    let (code, stderr) = mutated("examples/tet.obj", "f -4 -1 -2", "f 4 2 1", &["-pQ"]);
+    assert_eq!(code, Some(3), "{stderr}");
+    assert!(stderr.contains("1 duplicate polygon(s)"), "{stderr}");
+    assert!(stderr.contains("polygon 1 and facet 4"), "{stderr}");
+}
+
+#[test]
 fn coincident_points_are_merged_with_a_warning() {
     let (code, _, stderr, files) = run("coincident_points.poly", &["-p", "--check"]);
     assert_eq!(code, 0, "{stderr}");

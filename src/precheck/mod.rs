@@ -363,19 +363,36 @@ fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
 
 /// Duplicate polygons: the same set of (representative) vertices.
 pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
+    // Triangles (most polygons) are keyed without allocating; a triangle can only
+    // duplicate a triangle.
+    let mut triangles: FxHashMap<[u32; 3], (usize, usize)> = FxHashMap::default();
     let mut by_set: FxHashMap<Vec<u32>, (usize, usize)> = FxHashMap::default();
     let mut dups: Vec<((usize, usize), (usize, usize))> = Vec::new();
     for (fi, f) in plc.facets.iter().enumerate() {
         for (pi, poly) in f.polygons.iter().enumerate() {
-            let mut key = clean_ring(poly, rep);
-            if key.len() < 3 {
-                continue;
-            }
-            key.sort_unstable();
-            if let Some(&first) = by_set.get(&key) {
-                dups.push((first, (fi, pi)));
+            let first = if let [a, b, c] = poly[..] {
+                let mut key = [a, b, c].map(|v| rep.get(v as usize).copied().unwrap_or(v));
+                if key[0] == key[1] || key[1] == key[2] || key[0] == key[2] {
+                    continue;
+                }
+                key.sort_unstable();
+                *triangles.entry(key).or_insert((fi, pi))
             } else {
-                by_set.insert(key, (fi, pi));
+                let mut key = clean_ring(poly, rep);
+                if key.len() < 3 {
+                    continue;
+                }
+                key.sort_unstable();
+                if key.len() == 3 {
+                    *triangles
+                        .entry([key[0], key[1], key[2]])
+                        .or_insert((fi, pi))
+                } else {
+                    *by_set.entry(key).or_insert((fi, pi))
+                }
+            };
+            if first != (fi, pi) {
+                dups.push((first, (fi, pi)));
             }
         }
     }
