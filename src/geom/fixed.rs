@@ -51,6 +51,23 @@ impl I320 {
         }
     }
 
+    /// The nearest `f64` times `2^scale`, up to a few units in the last place, with the
+    /// exact sign.
+    fn to_f64_scaled(self, scale: i32) -> f64 {
+        let negative = self.is_negative();
+        let m = self.abs().0;
+        let mut x = 0.0f64;
+        for (i, &l) in m.iter().enumerate().rev() {
+            x += l as f64 * 2f64.powi(64 * i as i32);
+        }
+        let y = times_pow2(x, scale);
+        if negative {
+            -y
+        } else {
+            y
+        }
+    }
+
     /// -1, 0 or 1.
     pub fn signum(&self) -> i32 {
         if self.is_negative() {
@@ -127,9 +144,24 @@ impl Mul for I320 {
 /// and the determinant below 2^308.
 const SPAN_BITS: i32 = 58;
 
-/// The coordinates as integers in units of their common lowest set bit, or `None` when
-/// they span more than [`SPAN_BITS`] bits or one is subnormal or not finite.
-fn to_integers<const N: usize>(p: [&Point; N]) -> Option<[[i64; 3]; N]> {
+/// `x · 2^e`, in steps that keep each factor representable.
+fn times_pow2(x: f64, e: i32) -> f64 {
+    let (mut y, mut e) = (x, e);
+    while e > 1000 {
+        y *= 2f64.powi(1000);
+        e -= 1000;
+    }
+    while e < -1000 {
+        y *= 2f64.powi(-1000);
+        e += 1000;
+    }
+    y * 2f64.powi(e)
+}
+
+/// The coordinates as integers in units of their common lowest set bit `2^lo`, with
+/// `lo`, or `None` when they span more than [`SPAN_BITS`] bits or one is subnormal or
+/// not finite.
+fn to_integers<const N: usize>(p: [&Point; N]) -> Option<([[i64; 3]; N], i32)> {
     let (mut lo, mut hi) = (i32::MAX, i32::MIN);
     for x in p.iter().flat_map(|q| q.iter()) {
         if *x == 0.0 {
@@ -145,34 +177,35 @@ fn to_integers<const N: usize>(p: [&Point; N]) -> Option<[[i64; 3]; N]> {
         hi = hi.max(exp - 1023);
     }
     if lo == i32::MAX {
-        return Some([[0; 3]; N]);
+        return Some(([[0; 3]; N], 0));
     }
     if hi - lo > SPAN_BITS {
         return None;
     }
     // Scaling by a power of two is exact (no overflow: the result is below 2^59).
-    let scale = |x: f64| {
-        let mut y = x;
-        let mut e = -lo;
-        // powi of 2 may not be representable for large |lo|: scale in steps.
-        while e > 1000 {
-            y *= 2f64.powi(1000);
-            e -= 1000;
-        }
-        while e < -1000 {
-            y *= 2f64.powi(-1000);
-            e += 1000;
-        }
-        (y * 2f64.powi(e)) as i64
-    };
-    Some(p.map(|q| q.map(scale)))
+    Some((p.map(|q| q.map(|x| times_pow2(x, -lo) as i64)), lo))
+}
+
+/// Shewchuk's orientation determinant of `a, b, c, d` (positive when `d` lies below the
+/// plane of `a, b, c` seen counterclockwise from above), exact in sign and accurate in
+/// magnitude, or `None` when the coordinates do not fit the fixed-point path.
+pub fn orient3d(a: &Point, b: &Point, c: &Point, d: &Point) -> Option<f64> {
+    let ([a, b, c, d], lo) = to_integers([a, b, c, d])?;
+    let row = |p: [i64; 3]| std::array::from_fn::<i128, 3, _>(|k| (p[k] - d[k]) as i128);
+    let (a, b, c) = (row(a), row(b), row(c));
+    // Differences below 2^60; 2x2 minors below 2^121 fit in i128.
+    let big = I320::from_i128;
+    let det = big(a[2]) * big(b[0] * c[1] - c[0] * b[1])
+        + big(b[2]) * big(c[0] * a[1] - a[0] * c[1])
+        + big(c[2]) * big(a[0] * b[1] - b[0] * a[1]);
+    Some(det.to_f64_scaled(3 * lo))
 }
 
 /// The exact sign of Shewchuk's insphere determinant of `a, b, c, d, e` (positive when
 /// `e` is inside the sphere of a tet that is positive in Shewchuk's orientation), or
 /// `None` when the coordinates do not fit the fixed-point path.
 pub fn insphere(a: &Point, b: &Point, c: &Point, d: &Point, e: &Point) -> Option<i32> {
-    let [a, b, c, d, e] = to_integers([a, b, c, d, e])?;
+    let ([a, b, c, d, e], _) = to_integers([a, b, c, d, e])?;
     let row = |p: [i64; 3]| std::array::from_fn::<i64, 3, _>(|k| p[k] - e[k]);
     let r = [row(a), row(b), row(c), row(d)];
     // 2x2 minors and lifts fit in i128 (below 2^122); the rest is done in I320.
@@ -273,6 +306,43 @@ mod tests {
             checked > 15_000 && zeros > 5_000,
             "{checked} checked, {zeros} zeros"
         );
+    }
+
+    #[test]
+    fn orient3d_agrees_with_the_adaptive_one() {
+        let mut s = 5u64;
+        let mut zeros = 0;
+        for round in 0..20_000 {
+            let e0 = (round % 9) as i32 - 4;
+            let coord = |s: &mut u64| (lcg(s) * 40.0 + 1.0) * 2f64.powi(e0);
+            let mut p: [Point; 4] =
+                std::array::from_fn(|_| [coord(&mut s), coord(&mut s), coord(&mut s)]);
+            if round % 2 == 0 {
+                // Four corners of a box face: exactly coplanar, inexact differences.
+                let k = round % 3;
+                p[1][k] = p[0][k];
+                p[2][k] = p[0][k];
+                p[3][k] = p[0][k];
+                if round % 4 == 0 {
+                    p[3][k] = f64::from_bits(p[3][k].to_bits() + 1);
+                }
+            }
+            let c = |q: &Point| robust::Coord3D {
+                x: q[0],
+                y: q[1],
+                z: q[2],
+            };
+            let want = robust::orient3d(c(&p[0]), c(&p[1]), c(&p[2]), c(&p[3]));
+            let got = orient3d(&p[0], &p[1], &p[2], &p[3]).expect("fits");
+            assert_eq!(sign(got), sign(want), "{p:?}");
+            zeros += (want == 0.0) as usize;
+            // The adaptive predicate's value is itself only an estimate when it stops
+            // early: the magnitudes agree loosely, the signs exactly.
+            if want != 0.0 {
+                assert!(((got - want) / want).abs() < 1e-6, "{got} vs {want}");
+            }
+        }
+        assert!(zeros > 3000, "{zeros} coplanar cases");
     }
 
     #[test]

@@ -75,6 +75,9 @@ pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
     if bound > FILTER_MIN && bound < FILTER_MAX && (det > bound || -det > bound) {
         return -det;
     }
+    if let Some(det) = super::fixed::orient3d(a, b, c_, d) {
+        return -det;
+    }
     -robust::orient3d(c(a), c(b), c(c_), c(d))
 }
 
@@ -291,7 +294,7 @@ pub fn insphere_sos(p: [&Point; 5], ids: [u32; 5]) -> Sign {
 /// The perturbed sign of Shewchuk's (unnegated) insphere when the exact value is zero.
 fn insphere_perturbed(p: [&Point; 5], ids: [u32; 5]) -> Sign {
     perturbed_sign(p, ids, |r: &[&Point; 4]| {
-        Sign::of(robust::orient3d(c(r[0]), c(r[1]), c(r[2]), c(r[3])))
+        Sign::of(-orient3d(r[0], r[1], r[2], r[3]))
     })
 }
 
