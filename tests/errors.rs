@@ -302,6 +302,17 @@ fn open_facet_inside_a_closed_one_is_fine() {
 }
 
 #[test]
+fn facet_dangling_outside_is_carved_away_with_a_warning() {
+    let (code, _, stderr, _) = run("dangling_facet_outside.poly", &["-p", "--check"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("2 subsegment(s) lie outside the meshed domain")
+            && stderr.contains("first (5, 9)"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn intersecting_facets_exit_3_naming_the_pairs() {
     refused(
         "crossing_facets.poly",

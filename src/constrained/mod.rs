@@ -1206,18 +1206,32 @@ fn finish(
         .collect();
     subsegments.sort_unstable();
     // A polygon dangling in the exterior (a fin on a surface) is carved away with it;
-    // its edges then bound no tet and are not subsegments of the mesh.
-    let mut mesh_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
+    // its edges then bound no tet and are not subsegments of the mesh. Each vertex lists
+    // the subsegments it is the lower end of, and one pass over the tets marks those found.
+    let mut first = vec![0u32; n_out + 1];
+    for &([a, _], _) in &subsegments {
+        first[a as usize + 1] += 1;
+    }
+    for i in 0..n_out {
+        first[i + 1] += first[i];
+    }
+    // `subsegments` is sorted: each vertex's entries are contiguous, in order.
+    let mut found_edge = vec![false; subsegments.len()];
     for t in &tets {
-        for (a, b) in crate::mesh::EDGE_VERTS {
-            mesh_edges.insert(edge_key(t[a], t[b]));
+        for (i, j) in crate::mesh::EDGE_VERTS {
+            let (a, b) = edge_key(t[i], t[j]);
+            let range = first[a as usize] as usize..first[a as usize + 1] as usize;
+            if let Some(k) = subsegments[range.clone()].iter().position(|s| s.0[1] == b) {
+                found_edge[range.start + k] = true;
+            }
         }
     }
     let mut warnings = Vec::new();
     let before = subsegments.len();
     let mut first_lost = None;
+    let mut found_edge = found_edge.into_iter();
     subsegments.retain(|&([a, b], _)| {
-        let kept = mesh_edges.contains(&(a, b));
+        let kept = found_edge.next().unwrap_or(false);
         if !kept && first_lost.is_none() {
             first_lost = Some((a, b));
         }
