@@ -484,14 +484,14 @@ fn attempt(
     cdt.subsegs = seg_markers.clone();
     let mut queue: Vec<usize> = (0..prep.facets.len()).collect();
     queue.reverse();
-    let mut queued: FxHashSet<usize> = queue.iter().copied().collect();
+    let mut queued = vec![true; prep.facets.len()];
     let mut steiner: Vec<(usize, Point)> = Vec::new();
     let mut steiner_facets: FxHashSet<usize> = FxHashSet::default();
     let mut rounds = 0usize;
     let max_rounds = 20 * prep.facets.len() + 1000;
     while let Some(fi) = queue.pop() {
         opts.check_cancel()?;
-        queued.remove(&fi);
+        queued[fi] = false;
         rounds += 1;
         if rounds > max_rounds {
             return Err(MeshError::Failed("facet recovery does not converge".into()).into());
@@ -536,7 +536,8 @@ fn attempt(
                         stats.max_region_crossing_tets.max(rs.crossing_tets);
                     stats.enlarged_tets += rs.enlarged_tets;
                     for lf in rs.lost {
-                        if queued.insert(lf as usize) {
+                        if let Some(q) = queued.get_mut(lf as usize).filter(|q| !**q) {
+                            *q = true;
                             queue.push(lf as usize);
                         }
                     }

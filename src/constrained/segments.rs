@@ -90,7 +90,7 @@ pub fn recover_segments(
     // The pieces that are edges at the start, found in one pass over the tets (a walk
     // around each would cost much more). Each vertex lists its pieces' other ends, most
     // vertices have none or a few: cheaper than hashing every edge of every tet.
-    let present: rustc_hash::FxHashSet<(VertexId, VertexId)> = {
+    let (first, other, present) = {
         let n = dt.points.len();
         let mut first = vec![0u32; n + 1];
         for pc in &queue {
@@ -106,18 +106,30 @@ pub fn recover_segments(
             other[fill[lo] as usize] = pc.u.max(pc.v);
             fill[lo] += 1;
         }
-        let mut present = rustc_hash::FxHashSet::default();
+        let mut present = vec![false; other.len()];
         for t in dt.mesh.real_tets() {
             let v = dt.mesh.verts(t);
             for (i, j) in EDGE_VERTS {
                 let (a, b) = edge_key(v[i], v[j]);
-                let list = &other[first[a as usize] as usize..first[a as usize + 1] as usize];
-                if list.contains(&b) {
-                    present.insert((a, b));
+                let at = first[a as usize] as usize;
+                let list = &other[at..first[a as usize + 1] as usize];
+                if let Some(k) = list.iter().position(|&x| x == b) {
+                    present[at + k] = true;
                 }
             }
         }
-        present
+        (first, other, present)
+    };
+    let was_present = |u: VertexId, v: VertexId| {
+        let (a, b) = edge_key(u, v);
+        let (Some(&at), Some(&end)) = (first.get(a as usize), first.get(a as usize + 1)) else {
+            return false;
+        };
+        let (at, end) = (at as usize, end as usize);
+        other[at..end]
+            .iter()
+            .position(|&x| x == b)
+            .is_some_and(|k| present[at + k])
     };
     let mut done = Recovered::default();
     // Longest segments first (the queue is a stack): their split points are the
@@ -140,8 +152,7 @@ pub fn recover_segments(
         while let Some(pc) = queue.pop() {
             let hit = |v: VertexId| touched.get(v as usize).copied().unwrap_or(true);
             let untouched = !(hit(pc.u) && hit(pc.v));
-            if (untouched && present.contains(&edge_key(pc.u, pc.v)))
-                || edge_between(dt, pc.u, pc.v, &mut scratch)
+            if (untouched && was_present(pc.u, pc.v)) || edge_between(dt, pc.u, pc.v, &mut scratch)
             {
                 done.push(pc);
                 continue;
