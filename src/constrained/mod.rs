@@ -985,6 +985,12 @@ fn resolve_shims(
     if facet_verts.is_empty() {
         return (Vec::new(), None);
     }
+    // A shim's vertices are all on such a facet: most tets are ruled out without
+    // looking up their faces.
+    let mut on_some = vec![false; cdt.dt.points.len()];
+    for &v in facet_verts.values().flatten() {
+        on_some[v as usize] = true;
+    }
     for _round in 0..64 {
         let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         let kept = carved.kept_mask(cdt.dt.mesh.num_slots());
@@ -992,6 +998,9 @@ fn resolve_shims(
         let mut needs: Vec<(usize, Point)> = Vec::new();
         for &t in &carved.tets {
             let v = cdt.dt.mesh.verts(t);
+            if !v.iter().all(|&x| on_some[x as usize]) {
+                continue;
+            }
             let faces: [[VertexId; 3]; 4] =
                 crate::mesh::FACE_VERTS.map(|fv| face_key([v[fv[0]], v[fv[1]], v[fv[2]]]));
             let Some(facet) = faces.iter().find_map(|k| cdt.subfaces.get(k).copied()) else {

@@ -19,6 +19,7 @@ const FLAT: f64 = 1.5e-3;
 
 /// A merged facet's plane, with the slab and box within which a Steiner point counts as
 /// lying on it (four times the facet's own deviation from flat).
+#[derive(Clone)]
 struct Slab {
     normal: Point,
     mean: Point,
@@ -65,31 +66,68 @@ pub(crate) fn free_points(
     domain: &Domain<'_>,
     carved: &mut Option<Carved>,
 ) -> FlatTets {
+    // A tet can lie on one facet only if it has a Steiner point (which may lie in a
+    // slab), or if its four input vertices share a facet, which then has four or more:
+    // that rules out most tets before any geometry.
+    let n_input = input.len();
+    let mut on_big = vec![false; n_input];
+    for f in &prep.facets {
+        if f.rings.iter().map(|r| r.len()).sum::<usize>() >= 4 {
+            for &v in f.rings.iter().flatten() {
+                on_big[v as usize] = true;
+            }
+        }
+    }
+    let candidate = |v: [crate::mesh::VertexId; 4]| {
+        let o = v.map(|x| cdt.dt.orig[x as usize] as usize);
+        o.iter().any(|&x| x >= n_input) || o.iter().all(|&x| on_big[x])
+    };
     // Flat tets are few: find them before building the facets' slabs.
     let flat_tets: Vec<crate::mesh::TetId> = cdt
         .dt
         .mesh
         .live_tets()
-        .filter(|&t| !cdt.is_ghost(t))
+        .filter(|&t| !cdt.is_ghost(t) && candidate(cdt.dt.mesh.verts(t)))
         .filter(|&t| is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize])))
         .collect();
     if flat_tets.is_empty() {
         return FlatTets::default();
     }
-    let n_input = input.len();
     let diag = diagonal(input);
-    let mut facets_of: Vec<Vec<u32>> = vec![Vec::new(); n_input];
-    let mut slabs: Vec<Option<Slab>> = Vec::with_capacity(prep.facets.len());
-    for (fi, f) in prep.facets.iter().enumerate() {
+    // Which facets each input vertex is on, as lists per vertex (one flat array).
+    let ring_verts = |f: &super::prepare::MergedFacet| -> Vec<u32> {
         let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
         verts.sort_unstable();
         verts.dedup();
-        if verts.is_empty() || f.normal == [0.0; 3] {
-            slabs.push(None);
+        verts
+    };
+    let mut first = vec![0u32; n_input + 1];
+    for f in prep.facets.iter().filter(|f| f.normal != [0.0; 3]) {
+        for v in ring_verts(f) {
+            first[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..n_input {
+        first[i + 1] += first[i];
+    }
+    let mut on_facets = vec![0u32; first[n_input] as usize];
+    let mut fill = first.clone();
+    for (fi, f) in prep.facets.iter().enumerate() {
+        if f.normal == [0.0; 3] {
             continue;
         }
-        for &v in &verts {
-            facets_of[v as usize].push(fi as u32);
+        for v in ring_verts(f) {
+            on_facets[fill[v as usize] as usize] = fi as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let facets_of = |v: u32| &on_facets[first[v as usize] as usize..first[v as usize + 1] as usize];
+    // Slabs are built on demand: most facets never hold a flat tet.
+    let slab_of = |fi: usize| -> Option<Slab> {
+        let f = &prep.facets[fi];
+        let verts = ring_verts(f);
+        if verts.is_empty() || f.normal == [0.0; 3] {
+            return None;
         }
         let k = verts.len() as f64;
         let mean: Point =
@@ -111,14 +149,20 @@ pub(crate) fn free_points(
             }
         }
         slab.tol = (1e-10 * diag).max(4.0 * dev);
-        slabs.push(Some(slab));
-    }
-
-    let on = |orig: u32, p: &Point, f: u32| -> bool {
+        Some(slab)
+    };
+    let mut slab_cache: Vec<Option<Option<Slab>>> = Vec::new();
+    slab_cache.resize_with(prep.facets.len(), || None);
+    let mut slab_at = |fi: u32| -> Option<Slab> {
+        slab_cache[fi as usize]
+            .get_or_insert_with(|| slab_of(fi as usize))
+            .clone()
+    };
+    let mut on = |orig: u32, p: &Point, f: u32| -> bool {
         if (orig as usize) < n_input {
-            facets_of[orig as usize].contains(&f)
+            facets_of(orig).contains(&f)
         } else {
-            slabs[f as usize].as_ref().is_some_and(|s| s.holds(p))
+            slab_at(f).is_some_and(|s| s.holds(p))
         }
     };
     let mut flat: Vec<(crate::mesh::TetId, u32)> = Vec::new();
@@ -129,7 +173,7 @@ pub(crate) fn free_points(
         let candidates = o
             .iter()
             .filter(|&&x| (x as usize) < n_input)
-            .flat_map(|&x| facets_of[x as usize].iter().copied());
+            .flat_map(|&x| facets_of(x).iter().copied());
         for f in candidates {
             if (0..4).all(|i| on(o[i], &p[i], f)) {
                 flat.push((t, f));
@@ -140,6 +184,8 @@ pub(crate) fn free_points(
     if flat.is_empty() {
         return FlatTets::default();
     }
+    // A free point must leave every facet's slab: all are needed from here on.
+    let slabs: Vec<Option<Slab>> = (0..prep.facets.len() as u32).map(&mut slab_at).collect();
     let kept = carved
         .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
         .kept_mask(cdt.dt.mesh.num_slots());
