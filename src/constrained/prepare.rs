@@ -220,19 +220,12 @@ pub fn prepare_except(
             dsu.union(i, j);
         }
     }
-    // Edge users, one entry per occurrence, in polygon order.
-    let mut users: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
-    let mut edge_order: Vec<(u32, u32)> = Vec::new();
+    // Edge users, one entry per occurrence, sorted by edge then polygon: runs of one
+    // edge (sorting beats a map of lists: no allocation per edge).
+    let mut occurrences: Vec<((u32, u32), u32)> = Vec::new();
     for (i, p) in polys.iter().enumerate() {
         let v = &p.verts;
-        let mut add = |a: u32, b: u32| {
-            let k = (a.min(b), a.max(b));
-            let e = users.entry(k).or_insert_with(|| {
-                edge_order.push(k);
-                Vec::new()
-            });
-            e.push(i as u32);
-        };
+        let mut add = |a: u32, b: u32| occurrences.push(((a.min(b), a.max(b)), i as u32));
         match v.len() {
             1 => {}
             2 => add(v[0], v[1]),
@@ -243,6 +236,11 @@ pub fn prepare_except(
             }
         }
     }
+    occurrences.sort_unstable();
+    let edges: Vec<((u32, u32), &[((u32, u32), u32)])> = occurrences
+        .chunk_by(|x, y| x.0 == y.0)
+        .map(|run| (run[0].0, run))
+        .collect();
     let unit: Vec<Option<[f64; 3]>> = polys
         .iter()
         .map(|p| {
@@ -256,12 +254,11 @@ pub fn prepare_except(
         .collect();
     if merge {
         let cos_tol = MERGE_ANGLE_DEG.to_radians().cos();
-        for k in &edge_order {
-            let us = &users[k];
+        for (_, us) in &edges {
             if us.len() != 2 {
                 continue;
             }
-            let (a, b) = (us[0] as usize, us[1] as usize);
+            let (a, b) = (us[0].1 as usize, us[1].1 as usize);
             let apart = |i: usize| keep_apart.binary_search(&polys[i].facet).is_ok();
             if apart(a) || apart(b) {
                 continue;
@@ -277,12 +274,11 @@ pub fn prepare_except(
 
     // Segments.
     let mut segments: Vec<[u32; 2]> = Vec::new();
-    for k in &edge_order {
-        let us = &users[k];
+    for (k, us) in &edges {
         let interior = us.len() == 2
-            && polys[us[0] as usize].verts.len() > 2
-            && polys[us[1] as usize].verts.len() > 2
-            && dsu.find(us[0] as usize) == dsu.find(us[1] as usize);
+            && polys[us[0].1 as usize].verts.len() > 2
+            && polys[us[1].1 as usize].verts.len() > 2
+            && dsu.find(us[0].1 as usize) == dsu.find(us[1].1 as usize);
         if !interior {
             segments.push([k.0, k.1]);
         }
