@@ -116,6 +116,9 @@ pub(crate) fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
 /// Union-find with path halving.
 struct Dsu(Vec<usize>);
 
+/// One use of an edge (sorted vertex pair) by a polygon (its index).
+type EdgeUse = ((u32, u32), u32);
+
 impl Dsu {
     fn find(&mut self, mut i: usize) -> usize {
         while self.0[i] != i {
@@ -222,7 +225,7 @@ pub fn prepare_except(
     }
     // Edge users, one entry per occurrence, sorted by edge then polygon: runs of one
     // edge (sorting beats a map of lists: no allocation per edge).
-    let mut occurrences: Vec<((u32, u32), u32)> = Vec::new();
+    let mut occurrences: Vec<EdgeUse> = Vec::new();
     for (i, p) in polys.iter().enumerate() {
         let v = &p.verts;
         let mut add = |a: u32, b: u32| occurrences.push(((a.min(b), a.max(b)), i as u32));
@@ -237,7 +240,7 @@ pub fn prepare_except(
         }
     }
     occurrences.sort_unstable();
-    let edges: Vec<((u32, u32), &[((u32, u32), u32)])> = occurrences
+    let edges: Vec<((u32, u32), &[EdgeUse])> = occurrences
         .chunk_by(|x, y| x.0 == y.0)
         .map(|run| (run[0].0, run))
         .collect();
