@@ -824,8 +824,8 @@ struct FacetContext<'a> {
 type FacetTris = Result<Option<Vec<[VertexId; 3]>>, Error>;
 
 impl FacetContext<'_> {
-    /// Every facet's triangles, the facets split in two halves of about equal work, one
-    /// on a second core.
+    /// Every facet's triangles; with enough work, the facets split in two halves of about
+    /// equal work, one on a second core.
     fn triangulate_all(&self) -> Vec<FacetTris> {
         let facets = &self.prep.facets;
         let work: Vec<usize> = facets
@@ -833,6 +833,10 @@ impl FacetContext<'_> {
             .map(|f| f.rings.iter().map(|r| r.len()).sum::<usize>() + f.isolated.len() + 1)
             .collect();
         let total: usize = work.iter().sum();
+        // A thread costs more than a few small facets.
+        if total < 4096 {
+            return (0..facets.len()).map(|fi| self.triangles(fi)).collect();
+        }
         let mut acc = 0;
         let half = work
             .iter()
