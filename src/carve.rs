@@ -108,7 +108,16 @@ fn flood(cdt: &Cdt, stack: &mut Vec<TetId>, removed: &mut [bool]) {
 
 /// The real tet containing point `p`, if it lies inside the hull.
 pub(crate) fn containing_tet(cdt: &mut Cdt, p: &Point) -> Option<TetId> {
-    match cdt.dt.locate(p) {
+    match cdt.dt.locate_anywhere(p) {
+        Location::Inside(t) => Some(t),
+        Location::Vertex(v) => cdt.dt.mesh.vertex_tet(v).filter(|&t| !cdt.is_ghost(t)),
+        Location::Outside(_) => None,
+    }
+}
+
+/// [`containing_tet`], searching from tet `near`.
+pub(crate) fn containing_tet_near(cdt: &mut Cdt, near: TetId, p: &Point) -> Option<TetId> {
+    match cdt.dt.locate_anywhere_from(near, p) {
         Location::Inside(t) => Some(t),
         Location::Vertex(v) => cdt.dt.mesh.vertex_tet(v).filter(|&t| !cdt.is_ghost(t)),
         Location::Outside(_) => None,

@@ -35,6 +35,7 @@ fn run(name: &str, args: &[&str]) -> (i32, String, String, Vec<String>) {
         .current_dir(dir.path())
         .args(args)
         .arg(name)
+        .timeout(std::time::Duration::from_secs(120))
         .output()
         .unwrap();
     (
@@ -243,6 +244,20 @@ fn fuzz_regression_free_point_search_is_bounded() {
     // A meshing failure with its reason, not an abort.
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("Steiner points"), "{stderr}");
+}
+
+/// Found by `tests/fuzz.rs`: `star.off` with a vertex moved 1.8e19 units up made the
+/// walk that locates a candidate free point cycle for ever in the (non-Delaunay) CDT;
+/// the walk is now bounded, with a scan of every tet past the bound.
+#[test]
+fn fuzz_regression_point_location_in_the_cdt_ends() {
+    let (code, stderr) = mutated(
+        "plc/star.off",
+        "\n0.125 -0.125 0.125\n",
+        "\n0.125 -0.125 18446744073709551616\n",
+        &["-pQ", "--check"],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
 }
 
 #[test]

@@ -8,7 +8,7 @@
 
 use super::cdt::Cdt;
 use super::prepare::PreparedPlc;
-use crate::carve::{carve, containing_tet, Carved};
+use crate::carve::{carve, containing_tet_near, Carved};
 use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, dot, sub, Point};
 use crate::plc::Region;
@@ -198,7 +198,7 @@ pub(crate) fn free_points(
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        match remover(cdt, &kept, &p, slab, &slabs) {
+        match remover(cdt, &kept, t, &p, slab, &slabs) {
             Some(w) => {
                 if !out.points.contains(&w) {
                     out.points.push(w);
@@ -228,6 +228,7 @@ fn is_flat(p: &[Point; 4]) -> bool {
 fn remover(
     cdt: &mut Cdt,
     kept: &[bool],
+    tet: crate::mesh::TetId,
     p: &[Point; 4],
     slab: &Slab,
     slabs: &[Option<Slab>],
@@ -275,7 +276,7 @@ fn remover(
                 if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
                     continue;
                 }
-                if containing_tet(cdt, &w).is_some_and(|t| kept[t as usize]) {
+                if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
                     return Some(w);
                 }
             }

@@ -214,6 +214,28 @@ impl Delaunay {
 
     /// Locates point `p` by a visibility walk from the last tet created.
     pub fn locate(&mut self, p: &Point) -> Location {
+        self.locate_within(p, usize::MAX)
+    }
+
+    /// [`Delaunay::locate`] in a tetrahedralization that need not be Delaunay (a
+    /// constrained one), where the walk can cycle: past a bound on its steps, every tet
+    /// is tested instead. (In a Delaunay tetrahedralization the walk ends, though around
+    /// far-off vertices only after many steps.)
+    pub fn locate_anywhere(&mut self, p: &Point) -> Location {
+        self.locate_within(p, 4 * self.mesh.num_slots() + 1000)
+    }
+
+    /// [`Delaunay::locate_anywhere`], walking from tet `start` (a tet near `p` keeps the
+    /// walk short).
+    pub fn locate_anywhere_from(&mut self, start: TetId, p: &Point) -> Location {
+        if self.mesh.is_alive(start) {
+            self.last = start;
+        }
+        self.locate_anywhere(p)
+    }
+
+    /// The walk of [`Delaunay::locate`], giving up after `max_steps` for a scan.
+    fn locate_within(&mut self, p: &Point, max_steps: usize) -> Location {
         let mut t = self.last;
         if !self.mesh.is_alive(t) {
             t = self.mesh.real_tets().next().unwrap_or(0);
@@ -222,7 +244,12 @@ impl Delaunay {
             t = self.mesh.adj(FaceRef::new(t, 3)).tet();
         }
         let mut from = 4usize;
+        let mut steps = 0usize;
         loop {
+            steps += 1;
+            if steps > max_steps {
+                return self.locate_by_scan(p);
+            }
             let start = (self.next_rand() & 3) as usize;
             let mut next = None;
             let mut on_boundary = false;
@@ -260,6 +287,39 @@ impl Delaunay {
                     }
                 }
             }
+        }
+    }
+
+    /// [`Delaunay::locate`] by testing every live tet: a real tet holding `p`, else a
+    /// ghost tet whose hull face `p` lies beyond.
+    #[cold]
+    fn locate_by_scan(&self, p: &Point) -> Location {
+        let sees = |t: TetId, i: usize| {
+            let f = self.mesh.face_verts(t, i);
+            self.filter
+                .orient3d(self.pt(f[0]), self.pt(f[1]), self.pt(f[2]), p)
+        };
+        let mut outside = None;
+        for t in self.mesh.live_tets() {
+            if self.mesh.is_ghost(t) {
+                if outside.is_none() && sees(t, 3) > 0.0 {
+                    outside = Some(t);
+                }
+                continue;
+            }
+            let o = [0, 1, 2, 3].map(|i| sees(t, i));
+            if o.iter().all(|&x| x >= 0.0) {
+                if o.contains(&0.0) {
+                    if let Some(&v) = self.mesh.verts(t).iter().find(|&&v| self.pt(v) == p) {
+                        return Location::Vertex(v);
+                    }
+                }
+                return Location::Inside(t);
+            }
+        }
+        match outside {
+            Some(t) => Location::Outside(t),
+            None => Location::Inside(self.mesh.real_tets().next().unwrap_or(0)),
         }
     }
 

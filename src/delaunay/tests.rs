@@ -188,3 +188,39 @@ fn larger_random_set_is_valid() {
         }
     }
 }
+
+#[test]
+fn location_by_scan_agrees_with_the_walk() {
+    let pts = random_points(300, 9);
+    let mut dt = Delaunay::build(&pts).unwrap().dt;
+    let mut s = 77u64;
+    let (mut inside, mut outside) = (0, 0);
+    for k in 0..400 {
+        // Queries inside and around the unit cube, and the input points themselves.
+        let p: Point = if k % 10 == 0 {
+            pts[k % 300]
+        } else {
+            [0, 0, 0].map(|_| lcg(&mut s) * 1.6 - 0.3)
+        };
+        let walked = dt.locate(&p);
+        // A bound of no steps goes straight to the scan.
+        match (walked, dt.locate_within(&p, 0)) {
+            (Location::Inside(a), Location::Inside(b)) => {
+                assert_eq!(a, b, "{p:?}");
+                inside += 1;
+            }
+            (Location::Outside(_), Location::Outside(g)) => {
+                let f = dt.mesh.face_verts(g, 3);
+                assert!(dt.mesh.is_ghost(g));
+                assert!(orient3d(dt.pt(f[0]), dt.pt(f[1]), dt.pt(f[2]), &p) > 0.0);
+                outside += 1;
+            }
+            (Location::Vertex(a), Location::Vertex(b)) => assert_eq!(a, b),
+            (a, b) => panic!("{p:?}: walk {a:?}, scan {b:?}"),
+        }
+    }
+    assert!(
+        inside > 50 && outside > 50,
+        "{inside} inside, {outside} outside"
+    );
+}
