@@ -652,13 +652,7 @@ pub fn triangulate_facet(
     if !(nlen > 0.0 && nlen.is_finite()) {
         return Err("the facet normal is zero".into());
     }
-    let k = (0..3)
-        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-        .unwrap_or(2);
-    let (mut ax, mut ay) = ((k + 1) % 3, (k + 2) % 3);
-    if normal[k] < 0.0 {
-        std::mem::swap(&mut ax, &mut ay);
-    }
+    let (k, ax, ay) = projection(normal);
     let pts3: Vec<Point> = ids.iter().map(|&v| points[v as usize]).collect();
     let xy: Vec<[f64; 2]> = pts3.iter().map(|p| [p[ax], p[ay]]).collect();
     let mut lids: Vec<u32> = ids.iter().map(|&v| pert[v as usize]).collect();
@@ -745,17 +739,26 @@ pub fn triangulate_facet(
     run(g, n, &order, &cons, holes.len(), &ids)
 }
 
+/// The axis `k` along which `normal` is largest, and the two others `(ax, ay)` in the
+/// order that keeps counterclockwise (seen from `normal`'s side) counterclockwise in the
+/// projection.
+fn projection(normal: [f64; 3]) -> (usize, usize, usize) {
+    let k = (0..3)
+        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+        .unwrap_or(2);
+    let (ax, ay) = ((k + 1) % 3, (k + 2) % 3);
+    if normal[k] < 0.0 {
+        (k, ay, ax)
+    } else {
+        (k, ax, ay)
+    }
+}
+
 /// The output of [`triangulate_facet`] for a facet that is one triangle without holes,
 /// computed directly (most facets of surface meshes are), or `None` when its projection
 /// is degenerate and the general routine must decide.
 pub fn single_triangle(points: &[Point], tri: [u32; 3], normal: [f64; 3]) -> Option<[u32; 3]> {
-    let k = (0..3)
-        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-        .unwrap_or(2);
-    let (mut ax, mut ay) = ((k + 1) % 3, (k + 2) % 3);
-    if normal[k] < 0.0 {
-        std::mem::swap(&mut ax, &mut ay);
-    }
+    let (_, ax, ay) = projection(normal);
     let p = |v: u32| {
         let q = points.get(v as usize)?;
         Some([q[ax], q[ay]])
