@@ -73,6 +73,23 @@ impl Cdt {
         self.face_index = self.dt.mesh.face_index_of(self.dt.points.len(), wanted);
     }
 
+    /// The face `(a, b, c)` of the mesh from one of its tets, if present: the index's
+    /// hint when still valid, else a walk.
+    pub fn face_ref(&mut self, a: VertexId, b: VertexId, c: VertexId) -> Option<FaceRef> {
+        if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {
+            let t = f.tet();
+            let mesh = &self.dt.mesh;
+            if mesh.is_alive(t) {
+                let v = mesh.verts(t);
+                if v.contains(&a) && v.contains(&b) && v.contains(&c) {
+                    let i = (0..4).find(|&i| v[i] != a && v[i] != b && v[i] != c)?;
+                    return Some(FaceRef::new(t, i));
+                }
+            }
+        }
+        self.find_face(a, b, c)
+    }
+
     /// True if `(a, b, c)` is a face of the mesh.
     pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
         if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {

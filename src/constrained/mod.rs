@@ -1192,25 +1192,24 @@ fn finish(
         .iter()
         .map(|&t| cdt.dt.mesh.verts(t).map(orig))
         .collect();
-    // One pass over the kept tets finds every subface with a kept side (a walk to each
-    // subface would cost more).
-    let mut found: Vec<([VertexId; 3], [u32; 3], i32)> = Vec::new();
-    for &t in &carved.tets {
-        let v = cdt.dt.mesh.verts(t);
-        for (i, fv) in crate::mesh::FACE_VERTS.iter().enumerate() {
-            let k = face_key([v[fv[0]], v[fv[1]], v[fv[2]]]);
-            let Some(&f) = cdt.subfaces.get(&k) else {
-                continue;
-            };
-            // A subface with two kept sides is written once, from its lower tet.
-            let n = cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet();
-            if kept[n as usize] && n < t {
-                continue;
-            }
-            // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
-            let w = cdt.dt.mesh.face_verts(t, i).map(orig);
-            found.push((k, w, prep.facets[f as usize].marker));
-        }
+    // Each subface is found through the face index's hint (a walk only where the mesh
+    // changed since), and written from a kept side: from the lower tet if both are kept.
+    let keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
+    let mut found: Vec<([VertexId; 3], [u32; 3], i32)> = Vec::with_capacity(keys.len());
+    for (k, f) in keys {
+        let Some(a) = cdt.face_ref(k[0], k[1], k[2]) else {
+            continue;
+        };
+        let b = cdt.dt.mesh.adj(a);
+        let side = match (kept[a.tet() as usize], kept[b.tet() as usize]) {
+            (true, true) if b.tet() < a.tet() => b,
+            (true, _) => a,
+            (false, true) => b,
+            (false, false) => continue,
+        };
+        // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
+        let w = cdt.dt.mesh.face_verts(side.tet(), side.face()).map(orig);
+        found.push((k, w, prep.facets[f as usize].marker));
     }
     found.sort_unstable_by_key(|x| x.0);
     let subfaces: Vec<([u32; 3], i32)> = found.into_iter().map(|(_, w, m)| (w, m)).collect();
