@@ -78,6 +78,8 @@ impl Cdt {
     pub fn face_ref(&mut self, a: VertexId, b: VertexId, c: VertexId) -> Option<FaceRef> {
         if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {
             let t = f.tet();
+            // The tet may have been deleted or reused since; if it still has the three
+            // vertices, the face is there.
             let mesh = &self.dt.mesh;
             if mesh.is_alive(t) {
                 let v = mesh.verts(t);
@@ -92,19 +94,7 @@ impl Cdt {
 
     /// True if `(a, b, c)` is a face of the mesh.
     pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
-        if let Some(&f) = self.face_index.get(&face_key([a, b, c])) {
-            let t = f.tet();
-            // The tet may have been deleted or reused since; if it still has the three
-            // vertices, the face is there.
-            let mesh = &self.dt.mesh;
-            if mesh.is_alive(t) {
-                let v = mesh.verts(t);
-                if v.contains(&a) && v.contains(&b) && v.contains(&c) {
-                    return true;
-                }
-            }
-        }
-        self.find_face(a, b, c).is_some()
+        self.face_ref(a, b, c).is_some()
     }
 
     /// True if `u`–`v` is a mesh edge.

@@ -500,18 +500,17 @@ fn attempt(
             continue;
         }
         let f = &prep.facets[fi];
-        let tris = match &mut facet_tris[fi] {
-            Ok(Some(tris)) => tris.clone(),
+        let tris = match &facet_tris[fi] {
+            Ok(Some(tris)) => tris,
             Ok(None) => continue,
-            Err(e) => {
-                return Err(std::mem::replace(
-                    e,
-                    MeshError::Failed(String::new()).into(),
-                ))
+            // The error is taken out to be returned.
+            Err(_) => {
+                std::mem::replace(&mut facet_tris[fi], Ok(None))?;
+                continue;
             }
         };
         let mut missing = Vec::new();
-        for t in &tris {
+        for t in tris {
             if cdt.has_face(t[0], t[1], t[2]) {
                 cdt.subfaces.insert(face_key(*t), fi as u32);
             } else {
@@ -1194,8 +1193,9 @@ fn finish(
         .collect();
     // Each subface is found through the face index's hint (a walk only where the mesh
     // changed since), and written from a kept side: from the lower tet if both are kept.
-    let keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
-    let mut found: Vec<([VertexId; 3], [u32; 3], i32)> = Vec::with_capacity(keys.len());
+    let mut keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
+    keys.sort_unstable();
+    let mut subfaces: Vec<([u32; 3], i32)> = Vec::with_capacity(keys.len());
     for (k, f) in keys {
         let Some(a) = cdt.face_ref(k[0], k[1], k[2]) else {
             continue;
@@ -1209,10 +1209,8 @@ fn finish(
         };
         // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
         let w = cdt.dt.mesh.face_verts(side.tet(), side.face()).map(orig);
-        found.push((k, w, prep.facets[f as usize].marker));
+        subfaces.push((w, prep.facets[f as usize].marker));
     }
-    found.sort_unstable_by_key(|x| x.0);
-    let subfaces: Vec<([u32; 3], i32)> = found.into_iter().map(|(_, w, m)| (w, m)).collect();
     let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
         .iter()
         .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
@@ -1221,21 +1219,14 @@ fn finish(
     // A polygon dangling in the exterior (a fin on a surface) is carved away with it;
     // its edges then bound no tet and are not subsegments of the mesh. Each vertex lists
     // the subsegments it is the lower end of, and one pass over the tets marks those found.
-    let mut first = vec![0u32; n_out + 1];
-    for &([a, _], _) in &subsegments {
-        first[a as usize + 1] += 1;
-    }
-    for i in 0..n_out {
-        first[i + 1] += first[i];
-    }
-    // `subsegments` is sorted: each vertex's entries are contiguous, in order.
+    let at = crate::mesh::VertexLists::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
+    // `subsegments` is sorted: the lists are in its order.
     let mut found_edge = vec![false; subsegments.len()];
     for t in &tets {
         for (i, j) in crate::mesh::EDGE_VERTS {
             let (a, b) = edge_key(t[i], t[j]);
-            let range = first[a as usize] as usize..first[a as usize + 1] as usize;
-            if let Some(k) = subsegments[range.clone()].iter().position(|s| s.0[1] == b) {
-                found_edge[range.start + k] = true;
+            if let Some(k) = at.of(a).iter().position(|&x| x == b) {
+                found_edge[at.start(a) + k] = true;
             }
         }
     }

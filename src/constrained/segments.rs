@@ -90,46 +90,24 @@ pub fn recover_segments(
     // The pieces that are edges at the start, found in one pass over the tets (a walk
     // around each would cost much more). Each vertex lists its pieces' other ends, most
     // vertices have none or a few: cheaper than hashing every edge of every tet.
-    let (first, other, present) = {
-        let n = dt.points.len();
-        let mut first = vec![0u32; n + 1];
-        for pc in &queue {
-            first[pc.u.min(pc.v) as usize + 1] += 1;
-        }
-        for i in 0..n {
-            first[i + 1] += first[i];
-        }
-        let mut other = vec![0 as VertexId; queue.len()];
-        let mut fill = first.clone();
-        for pc in &queue {
-            let lo = pc.u.min(pc.v) as usize;
-            other[fill[lo] as usize] = pc.u.max(pc.v);
-            fill[lo] += 1;
-        }
-        let mut present = vec![false; other.len()];
-        for t in dt.mesh.real_tets() {
-            let v = dt.mesh.verts(t);
-            for (i, j) in EDGE_VERTS {
-                let (a, b) = edge_key(v[i], v[j]);
-                let at = first[a as usize] as usize;
-                let list = &other[at..first[a as usize + 1] as usize];
-                if let Some(k) = list.iter().position(|&x| x == b) {
-                    present[at + k] = true;
-                }
+    let other = crate::mesh::VertexLists::new(
+        dt.points.len(),
+        queue.iter().map(|pc| (pc.u.min(pc.v), pc.u.max(pc.v))),
+    );
+    let mut present = vec![false; other.len()];
+    for t in dt.mesh.real_tets() {
+        let v = dt.mesh.verts(t);
+        for (i, j) in EDGE_VERTS {
+            let (a, b) = edge_key(v[i], v[j]);
+            if let Some(k) = other.of(a).iter().position(|&x| x == b) {
+                present[other.start(a) + k] = true;
             }
         }
-        (first, other, present)
-    };
+    }
     let was_present = |u: VertexId, v: VertexId| {
         let (a, b) = edge_key(u, v);
-        let (Some(&at), Some(&end)) = (first.get(a as usize), first.get(a as usize + 1)) else {
-            return false;
-        };
-        let (at, end) = (at as usize, end as usize);
-        other[at..end]
-            .iter()
-            .position(|&x| x == b)
-            .is_some_and(|k| present[at + k])
+        let k = other.of(a).iter().position(|&x| x == b);
+        k.is_some_and(|k| present[other.start(a) + k])
     };
     let mut done = Recovered::default();
     // Longest segments first (the queue is a stack): their split points are the

@@ -101,27 +101,15 @@ pub(crate) fn free_points(
         verts.dedup();
         verts
     };
-    let mut first = vec![0u32; n_input + 1];
-    for f in prep.facets.iter().filter(|f| f.normal != [0.0; 3]) {
-        for v in ring_verts(f) {
-            first[v as usize + 1] += 1;
-        }
-    }
-    for i in 0..n_input {
-        first[i + 1] += first[i];
-    }
-    let mut on_facets = vec![0u32; first[n_input] as usize];
-    let mut fill = first.clone();
-    for (fi, f) in prep.facets.iter().enumerate() {
-        if f.normal == [0.0; 3] {
-            continue;
-        }
-        for v in ring_verts(f) {
-            on_facets[fill[v as usize] as usize] = fi as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    let facets_of = |v: u32| &on_facets[first[v as usize] as usize..first[v as usize + 1] as usize];
+    let on_facets = crate::mesh::VertexLists::new(
+        n_input,
+        prep.facets
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.normal != [0.0; 3])
+            .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
+    );
+    let facets_of = |v: u32| on_facets.of(v);
     // Slabs are built on demand: most facets never hold a flat tet.
     let slab_of = |fi: usize| -> Option<Slab> {
         let f = &prep.facets[fi];

@@ -70,6 +70,65 @@ impl Tet {
     }
 }
 
+/// Lists of items per vertex in one flat array (compressed rows): each vertex's items
+/// are contiguous, in the order given. Cheaper than a map of lists when most vertices
+/// have few items or none.
+#[derive(Clone, Debug)]
+pub struct VertexLists<T> {
+    first: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T: Copy + Default> VertexLists<T> {
+    /// The lists of vertices `0..num_vertices` from `(vertex, item)` pairs (pairs whose
+    /// vertex is out of range are dropped).
+    pub fn new(num_vertices: usize, pairs: impl Iterator<Item = (VertexId, T)> + Clone) -> Self {
+        let mut first = vec![0u32; num_vertices + 1];
+        for (v, _) in pairs.clone().filter(|p| (p.0 as usize) < num_vertices) {
+            first[v as usize + 1] += 1;
+        }
+        for i in 0..num_vertices {
+            first[i + 1] += first[i];
+        }
+        let mut items = vec![T::default(); first[num_vertices] as usize];
+        let mut fill = first.clone();
+        for (v, x) in pairs.filter(|p| (p.0 as usize) < num_vertices) {
+            items[fill[v as usize] as usize] = x;
+            fill[v as usize] += 1;
+        }
+        VertexLists { first, items }
+    }
+
+    /// The items of vertex `v` (none for a vertex out of range).
+    #[inline]
+    pub fn of(&self, v: VertexId) -> &[T] {
+        let v = v as usize;
+        match (self.first.get(v), self.first.get(v + 1)) {
+            (Some(&a), Some(&b)) => &self.items[a as usize..b as usize],
+            _ => &[],
+        }
+    }
+
+    /// Where the items of vertex `v` start in the flat order of all items (for side
+    /// arrays indexed like them).
+    #[inline]
+    pub fn start(&self, v: VertexId) -> usize {
+        self.first
+            .get(v as usize)
+            .map_or(self.items.len(), |&a| a as usize)
+    }
+
+    /// The number of items over all vertices.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// True if no vertex has an item.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+}
+
 /// The tet arena with a free list and a vertex-to-tet map.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -282,19 +341,13 @@ impl Mesh {
         num_vertices: usize,
         wanted: &[[VertexId; 3]],
     ) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
-        let mut first = vec![0u32; num_vertices + 1];
-        for k in wanted.iter().filter(|k| (k[2] as usize) < num_vertices) {
-            first[k[0] as usize + 1] += 1;
-        }
-        for i in 0..num_vertices {
-            first[i + 1] += first[i];
-        }
-        let mut rest = vec![[0 as VertexId; 2]; first[num_vertices] as usize];
-        let mut fill = first.clone();
-        for k in wanted.iter().filter(|k| (k[2] as usize) < num_vertices) {
-            rest[fill[k[0] as usize] as usize] = [k[1], k[2]];
-            fill[k[0] as usize] += 1;
-        }
+        let rest = VertexLists::new(
+            num_vertices,
+            wanted
+                .iter()
+                .filter(|k| (k[2] as usize) < num_vertices)
+                .map(|k| (k[0], [k[1], k[2]])),
+        );
         let mut index = rustc_hash::FxHashMap::default();
         index.reserve(wanted.len());
         for t in self.real_tets() {
@@ -302,11 +355,7 @@ impl Mesh {
             for (i, fv) in FACE_VERTS.iter().enumerate() {
                 let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
                 k.sort_unstable();
-                let at = k[0] as usize;
-                if at >= num_vertices || first[at] == first[at + 1] {
-                    continue;
-                }
-                if rest[first[at] as usize..first[at + 1] as usize].contains(&[k[1], k[2]]) {
+                if rest.of(k[0]).contains(&[k[1], k[2]]) {
                     index.insert(k, FaceRef::new(t, i));
                 }
             }
@@ -348,6 +397,15 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn vertex_lists_keep_each_vertexs_items_in_order() {
+        let l = VertexLists::new(4, [(2, 'a'), (0, 'b'), (2, 'c'), (9, 'x')].into_iter());
+        assert_eq!(l.of(2), &['a', 'c']);
+        assert_eq!(l.of(0), &['b']);
+        assert!(l.of(1).is_empty() && l.of(3).is_empty() && l.of(9).is_empty());
+        assert_eq!((l.len(), l.start(2)), (3, 1));
+    }
 
     #[test]
     fn face_verts_are_even_permutations() {
