@@ -19,14 +19,15 @@
 //! and otherwise the region asks for a Steiner point on the polygon, like the cavity
 //! algorithm does.
 
+use super::bistellar::{self, Kind};
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
 use super::cdt::{edge_key, face_key, Cdt};
 use crate::error::MeshError;
 use crate::geom::lifted::{
     cross_sign, key_cross, Approx, CompareCounts, FlipTime, Lifting, TimeKey,
 };
-use crate::geom::{cross, dot, insphere_sos, orient3d, sub, Point, Sign};
-use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
+use crate::geom::{cross, dot, insphere_sos, sub, Point, Sign};
+use crate::mesh::{FaceRef, TetId, VertexId};
 use rustc_hash::FxHashSet;
 
 /// Figures of flip insertion, summed over regions.
@@ -699,104 +700,27 @@ impl<'a> Flipper<'a> {
         f: FaceRef,
         repair: bool,
     ) -> Result<Result<Vec<TetId>, Refusal>, MeshError> {
-        let mesh = &self.cdt.dt.mesh;
-        let (t1, i) = (f.tet(), f.face());
-        let g = mesh.adj(f);
-        let t2 = g.tet();
-        let v = mesh.verts(t1)[i];
-        let w = mesh.verts(t2)[g.face()];
-        let s = mesh.face_verts(t1, i);
-        let base = [s[0], s[1], s[2], v];
-        let rep = |k: usize| {
-            let mut b = base;
-            b[k] = w;
-            b
+        let Some(sh) = bistellar::shape(&self.cdt.dt.mesh, &self.cdt.dt.points, f) else {
+            return Ok(Err(Refusal::NotFlippable));
         };
-        let pts = &self.cdt.dt.points;
-        let orient = |t: &[VertexId; 4]| {
-            let p = t.map(|x| &pts[x as usize]);
-            orient3d(p[0], p[1], p[2], p[3])
+        let constrained = match &sh.edge {
+            None => self.region_faces.contains(&face_key(sh.face)),
+            Some(([e0, e1], apices)) => self.edge_is_constrained(*e0, *e1, apices),
         };
-        let o: [f64; 3] = std::array::from_fn(|k| orient(&rep(k)));
-        let neg: Vec<usize> = (0..3).filter(|&k| o[k] < 0.0).collect();
-        let zero: Vec<usize> = (0..3).filter(|&k| o[k] == 0.0).collect();
-        // The face of t1 opposite s[k] (it holds the edge of s without s[k], and v).
-        let opposite = |t: TetId, x: VertexId| {
-            let tv = mesh.verts(t);
-            (0..4).find(|&j| tv[j] == x)
-        };
-        let (old, new, kind): (Vec<TetId>, Vec<[VertexId; 4]>, usize) =
-            if neg.is_empty() && zero.is_empty() {
-                if self.region_faces.contains(&face_key(s)) {
-                    return Ok(Err(Refusal::Constrained));
-                }
-                (vec![t1, t2], vec![rep(0), rep(1), rep(2)], 23)
-            } else if neg.len() == 1 && zero.is_empty() {
-                let k = neg[0];
-                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
-                let Some(j) = opposite(t1, s[k]) else {
-                    return Ok(Err(Refusal::NotFlippable));
-                };
-                let t3 = mesh.adj(FaceRef::new(t1, j)).tet();
-                if !mesh.verts(t3).contains(&w) {
-                    return Ok(Err(Refusal::NotFlippable));
-                }
-                if self.edge_is_constrained(e0, e1, &[s[k], v, w]) {
-                    return Ok(Err(Refusal::Constrained));
-                }
-                (
-                    vec![t1, t2, t3],
-                    vec![rep((k + 1) % 3), rep((k + 2) % 3)],
-                    32,
-                )
-            } else if zero.len() == 1 && neg.is_empty() {
-                let k = zero[0];
-                let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
-                let (Some(j1), Some(j2)) = (opposite(t1, s[k]), opposite(t2, s[k])) else {
-                    return Ok(Err(Refusal::NotFlippable));
-                };
-                let t3 = mesh.adj(FaceRef::new(t1, j1)).tet();
-                let t4 = mesh.adj(FaceRef::new(t2, j2)).tet();
-                let t3v = mesh.verts(t3);
-                let t4v = mesh.verts(t4);
-                let Some(&u) = t3v.iter().find(|&&x| x != e0 && x != e1 && x != v) else {
-                    return Ok(Err(Refusal::NotFlippable));
-                };
-                if u == w || !t4v.contains(&u) || !t4v.contains(&w) {
-                    return Ok(Err(Refusal::NotFlippable));
-                }
-                if self.edge_is_constrained(e0, e1, &[s[k], v, w, u]) {
-                    return Ok(Err(Refusal::Constrained));
-                }
-                // On u's side: t3 with e0 (then e1) replaced by w.
-                let mut extra = Vec::new();
-                for e in [e0, e1] {
-                    let mut t = t3v;
-                    if let Some(p) = t.iter().position(|&x| x == e) {
-                        t[p] = w;
-                    }
-                    if orient(&t) <= 0.0 {
-                        return Ok(Err(Refusal::NotFlippable));
-                    }
-                    extra.push(t);
-                }
-                let mut new = vec![rep((k + 1) % 3), rep((k + 2) % 3)];
-                new.extend(extra);
-                (vec![t1, t2, t3, t4], new, 44)
-            } else {
-                return Ok(Err(Refusal::NotFlippable));
-            };
-        if old.iter().any(|&t| !self.in_r(t)) {
+        if constrained {
+            return Ok(Err(Refusal::Constrained));
+        }
+        if sh.old.iter().any(|&t| !self.in_r(t)) {
             return Ok(Err(Refusal::OutsideR));
         }
-        let made = self.replace(&old, &new)?;
+        let made = self.replace(&sh.old, &sh.new)?;
         if repair {
             self.counts.repair_flips += 1;
         } else {
-            match kind {
-                23 => self.counts.flips23 += 1,
-                32 => self.counts.flips32 += 1,
-                _ => self.counts.flips44 += 1,
+            match sh.kind {
+                Kind::T23 => self.counts.flips23 += 1,
+                Kind::T32 => self.counts.flips32 += 1,
+                Kind::T44 => self.counts.flips44 += 1,
             }
         }
         Ok(Ok(made))
@@ -812,64 +736,19 @@ impl<'a> Flipper<'a> {
     }
 
     /// Replaces tets `old` by the positively oriented tets `new` (which fill the same
-    /// volume), gluing them to each other and to the outside.
+    /// volume), keeping R's membership and noting the subfaces at risk.
     fn replace(&mut self, old: &[TetId], new: &[[VertexId; 4]]) -> Result<Vec<TetId>, MeshError> {
-        let mesh = &mut self.cdt.dt.mesh;
-        let mut outer: Vec<([VertexId; 3], FaceRef)> = Vec::with_capacity(8);
-        let check_subfaces = !self.cdt.subfaces.is_empty();
-        for &t in old {
-            for j in 0..4 {
-                let key = face_key(mesh.face_verts(t, j));
-                let n = mesh.adj(FaceRef::new(t, j));
-                if !old.contains(&n.tet()) {
-                    outer.push((key, n));
-                }
-                if check_subfaces && self.cdt.subfaces.contains_key(&key) {
-                    self.at_risk.push(key);
-                }
+        let subfaces = &self.cdt.subfaces;
+        let at_risk = &mut self.at_risk;
+        let made = bistellar::replace(&mut self.cdt.dt.mesh, old, new, |key| {
+            if !subfaces.is_empty() && subfaces.contains_key(&key) {
+                at_risk.push(key);
             }
-        }
+        })?;
         for &t in old {
-            mesh.kill_tet(t);
             self.marks.remove_tet(t);
         }
-        let mut made = Vec::with_capacity(new.len());
-        for &v in new {
-            let t = mesh
-                .add_tet(v)
-                .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
-            made.push(t);
-        }
-        let keys: Vec<[[VertexId; 3]; 4]> = new
-            .iter()
-            .map(|v| std::array::from_fn(|j| face_key(FACE_VERTS[j].map(|x| v[x]))))
-            .collect();
-        for a in 0..made.len() {
-            'faces: for j in 0..4 {
-                for b in 0..made.len() {
-                    if b == a {
-                        continue;
-                    }
-                    if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == keys[a][j]) {
-                        if b > a {
-                            mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
-                        }
-                        continue 'faces;
-                    }
-                }
-                let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == keys[a][j]) else {
-                    return Err(MeshError::Internal(format!(
-                        "a flip left face {:?} without a neighbour",
-                        keys[a][j]
-                    )));
-                };
-                mesh.glue(FaceRef::new(made[a], j), n);
-            }
-        }
         for &t in &made {
-            for x in mesh.verts(t) {
-                mesh.set_vertex_tet(x, t);
-            }
             self.marks.add_tet(t);
             self.r_list.push(t);
         }
@@ -958,6 +837,7 @@ impl<'a> Flipper<'a> {
 mod tests {
     use super::*;
     use crate::delaunay::Delaunay;
+    use crate::geom::orient3d;
 
     use crate::geom::lcg;
 

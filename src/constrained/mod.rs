@@ -6,11 +6,13 @@
 //! facet and the whole construction starts again from the Delaunay tetrahedralization:
 //! simple to get right, and rare in practice.
 
+mod bistellar;
 pub mod cavity;
 pub mod cdt;
 pub mod enclosure;
 pub mod facet2d;
 pub mod flip;
+mod free;
 pub mod prepare;
 pub mod segments;
 mod slivers;
@@ -579,9 +581,25 @@ fn attempt(
         };
         // Free points go straight into the CDT, round after round; only if one cannot
         // (its cavity would cross a constraint) does the construction start again with it.
+        // The input ends of the segment of each Steiner point on one, which name the
+        // facets a flat tet of such points may lie on.
+        let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
+        for chain in subsegs.chains.iter().filter(|c| c.len() > 2) {
+            let ends = [chain[0], chain[chain.len() - 1]].map(|x| cdt.dt.orig[x as usize]);
+            for &v in &chain[1..chain.len() - 1] {
+                seg_ends.insert(v, ends);
+            }
+        }
         let mut stuck = Vec::new();
         for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(&mut cdt, merged, &plc.points, &domain, &mut carved);
+            let found = slivers::free_points(
+                &mut cdt,
+                merged,
+                &plc.points,
+                &seg_ends,
+                &domain,
+                &mut carved,
+            );
             let free = found.points;
             stuck = found.stuck;
             if debug() && !free.is_empty() {
@@ -595,14 +613,26 @@ fn attempt(
             if free.is_empty() {
                 break;
             }
-            carved = None;
-            match insert_free(&mut cdt, free, &mut next_pert) {
-                Ok(n) => stats.free_steiner_points += n,
-                Err(_) => {
-                    steiner.extend(free.iter().map(|&p| (FREE_POINT, p)));
-                    break;
-                }
+            let (added, refused) = free::insert_free(&mut cdt, free, &mut next_pert)?;
+            stats.free_steiner_points += added;
+            if added > 0 {
+                carved = None;
+                continue;
             }
+            // None fits into the CDT as it stands: the construction starts again with
+            // them, if that restart stays well within the bounds on restarts.
+            if debug() {
+                eprintln!("free points refused by the CDT: {refused:?}");
+            }
+            // A point that an earlier attempt already had is not tried again.
+            let new = refused
+                .iter()
+                .filter(|p| !facet_points.iter().any(|(_, q)| q == *p))
+                .map(|&p| (FREE_POINT, p));
+            if stats.restarts + 1 < MAX_FREE_ROUNDS && stats.crossing_tests < RESTART_WORK / 4 {
+                steiner.extend(new);
+            }
+            break;
         }
         stats.steiner_points += stats.free_steiner_points;
         // A flat tet whose circumsphere lies within its facet's slab spans a gap between
@@ -658,52 +688,6 @@ fn flat_tet_splits(
         }
     }
     out
-}
-
-/// Inserts free points into the CDT, each with a cavity walled in by the subfaces, and
-/// returns how many it added. Fails if a cavity would cross a subface or remove a
-/// subsegment: the CDT is then broken and must be discarded.
-fn insert_free(cdt: &mut Cdt, free: &[Point], next_pert: &mut u32) -> Result<usize, MeshError> {
-    let mut at: FxHashMap<VertexId, Vec<VertexId>> = FxHashMap::default();
-    for &(a, b) in cdt.subsegs.keys() {
-        at.entry(a).or_default().push(b);
-        at.entry(b).or_default().push(a);
-    }
-    let mut cavity = Vec::new();
-    let mut added = 0;
-    for &w in free {
-        let subfaces = &cdt.subfaces;
-        let blocked = |v: [VertexId; 4], f: usize| {
-            let fv = crate::mesh::FACE_VERTS[f];
-            subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
-        };
-        if cdt
-            .dt
-            .insert_steiner_blocked(w, *next_pert, blocked)?
-            .is_none()
-        {
-            continue;
-        }
-        if !cdt.dt.last_cavity_is_delaunay(blocked) {
-            return Err(MeshError::Internal(
-                "a free point's cavity is not constrained Delaunay".into(),
-            ));
-        }
-        *next_pert += 1;
-        added += 1;
-        // Only edges between vertices of the cavity can have gone.
-        cdt.dt.last_cavity_vertices(&mut cavity);
-        for &x in &cavity {
-            for &y in at.get(&x).map(|v| v.as_slice()).unwrap_or(&[]) {
-                if x < y && cavity.binary_search(&y).is_ok() && !cdt.has_edge(x, y) {
-                    return Err(MeshError::Internal(format!(
-                        "a free point removed subsegment ({x}, {y})"
-                    )));
-                }
-            }
-        }
-    }
-    Ok(added)
 }
 
 /// The triangles of `tris` on the inner side of `f`'s rings, flooding across edges that

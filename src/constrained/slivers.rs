@@ -11,7 +11,9 @@ use super::prepare::PreparedPlc;
 use crate::carve::{carve, containing_tet_near, Carved};
 use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, dot, sub, Point};
+use crate::mesh::VertexId;
 use crate::plc::Region;
+use rustc_hash::FxHashMap;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
 /// referee's measure (1e-3) with a margin, so that what we remove is what it flags.
@@ -49,8 +51,10 @@ pub(crate) struct Domain<'a> {
 /// What [`free_points`] found.
 #[derive(Default)]
 pub(crate) struct FlatTets {
-    /// Free vertices that remove flat tets, one per tet.
-    pub points: Vec<Point>,
+    /// Free vertices that remove flat tets: for each tet, the candidates in order of
+    /// preference (a point that would break the CDT, by encroaching upon a subsegment,
+    /// gives way to the next).
+    pub points: Vec<Vec<Point>>,
     /// The kept flat tets for which no free vertex was found (their circumspheres lie
     /// within the facet's slab), by their vertices.
     pub stuck: Vec<[crate::mesh::VertexId; 4]>,
@@ -63,6 +67,7 @@ pub(crate) fn free_points(
     cdt: &mut Cdt,
     prep: &PreparedPlc,
     input: &[Point],
+    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
     domain: &Domain<'_>,
     carved: &mut Option<Carved>,
 ) -> FlatTets {
@@ -158,10 +163,18 @@ pub(crate) fn free_points(
         let v = cdt.dt.mesh.verts(t);
         let p = v.map(|x| cdt.dt.points[x as usize]);
         let o = v.map(|x| cdt.dt.orig[x as usize]);
-        let candidates = o
-            .iter()
-            .filter(|&&x| (x as usize) < n_input)
-            .flat_map(|&x| facets_of(x).iter().copied());
+        // A tet of Steiner points on segments (between nearly parallel segments) has no
+        // input vertex to name its facet: the segments' ends do.
+        let mut candidates: Vec<u32> = Vec::new();
+        for i in 0..4 {
+            if (o[i] as usize) < n_input {
+                candidates.extend_from_slice(facets_of(o[i]));
+            } else if let Some(ends) = seg_ends.get(&v[i]) {
+                candidates.extend(ends.iter().flat_map(|&x| facets_of(x).iter().copied()));
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
         for f in candidates {
             if (0..4).all(|i| on(o[i], &p[i], f)) {
                 flat.push((t, f));
@@ -186,13 +199,11 @@ pub(crate) fn free_points(
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        match remover(cdt, &kept, t, &p, slab, &slabs) {
-            Some(w) => {
-                if !out.points.contains(&w) {
-                    out.points.push(w);
-                }
-            }
-            None => out.stuck.push(cdt.dt.mesh.verts(t)),
+        let ws = remover(cdt, &kept, t, &p, slab, &slabs);
+        if ws.is_empty() {
+            out.stuck.push(cdt.dt.mesh.verts(t));
+        } else if !out.points.iter().any(|x| x[0] == ws[0]) {
+            out.points.push(ws);
         }
     }
     out
@@ -209,10 +220,13 @@ fn is_flat(p: &[Point; 4]) -> bool {
     det.abs() / 6.0 <= FLAT * l2 * l2.sqrt()
 }
 
-/// A point inside the tet's circumsphere, off every facet's slab and inside a kept tet.
-/// It is sought on lines along the facet's normal through the tet's centroid, its
-/// circumcenter and the point halfway, farthest from the facet first: a flat tet along
-/// an edge where two facets meet has its sphere off to one side.
+/// The number of places [`remover`] offers for one flat tet.
+const CANDIDATES: usize = 6;
+
+/// Points inside the tet's circumsphere, off every facet's slab and inside a kept tet,
+/// best first. They are sought on lines along the facet's normal through the tet's
+/// centroid, its circumcenter and the point halfway, farthest from the facet first: a
+/// flat tet along an edge where two facets meet has its sphere off to one side.
 fn remover(
     cdt: &mut Cdt,
     kept: &[bool],
@@ -220,10 +234,11 @@ fn remover(
     p: &[Point; 4],
     slab: &Slab,
     slabs: &[Option<Slab>],
-) -> Option<Point> {
+) -> Vec<Point> {
+    let mut found = Vec::new();
     let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
     if o == 0.0 {
-        return None;
+        return found;
     }
     let l2 = longest_edge2(p);
     let m: Point = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k] + p[3][k]) / 4.0);
@@ -264,13 +279,19 @@ fn remover(
                 if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
                     continue;
                 }
+                if found.contains(&w) {
+                    continue;
+                }
                 if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
-                    return Some(w);
+                    found.push(w);
+                    if found.len() == CANDIDATES {
+                        return found;
+                    }
                 }
             }
         }
     }
-    None
+    found
 }
 
 /// The tet's circumcenter and radius, when they are finite.

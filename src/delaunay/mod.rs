@@ -51,6 +51,17 @@ pub struct Delaunay {
     filter: StaticFilter,
 }
 
+/// What [`Delaunay::blocked_cavity`] found.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Cavity {
+    /// The point coincides with a vertex.
+    OnVertex,
+    /// The cavity wraps around a blocked face: filling it would break the mesh.
+    Wraps,
+    /// The cavity is ready to be filled.
+    Ready,
+}
+
 /// A tet to be made by an insertion: its vertices (the new vertex in slot `face`) and
 /// the outside face it is glued to across face `face`.
 #[derive(Copy, Clone, Debug)]
@@ -404,6 +415,22 @@ impl Delaunay {
         pv: VertexId,
         blocked: impl Fn([VertexId; 4], usize) -> bool,
     ) -> Result<bool, MeshError> {
+        match self.blocked_cavity(pv, blocked)? {
+            Cavity::OnVertex => Ok(false),
+            Cavity::Wraps => Err(MeshError::Internal(
+                "the cavity of a vertex wraps around a constraint".into(),
+            )),
+            Cavity::Ready => self.fill_cavity(),
+        }
+    }
+
+    /// Finds the cavity of vertex `pv` walled in by the `blocked` faces (in `conflict`
+    /// and `boundary`), without changing the mesh.
+    fn blocked_cavity(
+        &mut self,
+        pv: VertexId,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<Cavity, MeshError> {
         let p = *self.pt(pv);
         let [lo, hi] = self.bbox;
         if (0..3).any(|k| !(lo[k] <= p[k] && p[k] <= hi[k])) {
@@ -414,7 +441,7 @@ impl Delaunay {
             ]);
         }
         let start = match self.locate(&p) {
-            Location::Vertex(_) => return Ok(false),
+            Location::Vertex(_) => return Ok(Cavity::OnVertex),
             Location::Inside(t) | Location::Outside(t) => t,
         };
         // The constrained stages add tets behind this struct's back.
@@ -431,6 +458,7 @@ impl Delaunay {
         self.mark[start as usize] = IN_CONFLICT;
         self.conflict.push(start);
         let mut walled = false;
+        let mut wraps = false;
         let mut k = 0;
         while k < self.conflict.len() {
             let t = self.conflict[k];
@@ -444,13 +472,15 @@ impl Delaunay {
             for (f, &outside) in tet.adj.iter().enumerate() {
                 let n = outside.tet();
                 let state = self.mark[n as usize];
-                if state == IN_CONFLICT {
+                if blocked(tet.v, f) {
+                    // A wall: the tet behind it is left unmarked, since the cavity may
+                    // still reach it around the wall, which is then destroyed (below).
+                    walled = true;
+                    wraps |= state == IN_CONFLICT;
+                } else if state == IN_CONFLICT {
                     continue;
-                }
-                if state != OUTSIDE {
-                    if blocked(tet.v, f) {
-                        walled = true;
-                    } else if self.in_conflict_with(n, around[f], &p, pv) {
+                } else if state != OUTSIDE {
+                    if self.in_conflict_with(n, around[f], &p, pv) {
                         self.mark[n as usize] = IN_CONFLICT;
                         self.conflict.push(n);
                         continue;
@@ -477,10 +507,11 @@ impl Delaunay {
                 .map(|v| self.orientation(v))
         };
         if walled
-            && self.boundary.iter().any(|b| {
-                self.mark[b.outside.tet() as usize] == IN_CONFLICT
-                    || (b.v[3] != GHOST && Some(self.orientation(b.v)) != reference())
-            })
+            && (wraps
+                || self.boundary.iter().any(|b| {
+                    self.mark[b.outside.tet() as usize] == IN_CONFLICT
+                        || (b.v[3] != GHOST && Some(self.orientation(b.v)) != reference())
+                }))
         {
             for i in 0..self.conflict.len() {
                 self.mark[self.conflict[i] as usize] = 0;
@@ -488,11 +519,9 @@ impl Delaunay {
             for i in 0..self.boundary.len() {
                 self.mark[self.boundary[i].outside.tet() as usize] = 0;
             }
-            return Err(MeshError::Internal(
-                "the cavity of a vertex wraps around a constraint".into(),
-            ));
+            return Ok(Cavity::Wraps);
         }
-        self.fill_cavity()
+        Ok(Cavity::Ready)
     }
 
     /// Replaces the conflict tets by the fan of new tets from the new vertex to the cavity
@@ -699,6 +728,7 @@ fn collinear(a: &Point, b: &Point, c: &Point) -> bool {
 mod tests;
 
 mod steiner;
+pub use steiner::{Change, Walled};
 
 /// A finished triangulation in output form (see [`Delaunay::export_with`]).
 #[derive(Clone, Debug, Default)]

@@ -4,7 +4,35 @@
 use super::Delaunay;
 use crate::error::MeshError;
 use crate::geom::Point;
-use crate::mesh::{FaceRef, TetId, VertexId, GHOST};
+use crate::mesh::{FaceRef, Tet, TetId, VertexId, GHOST};
+
+/// What [`Delaunay::insert_walled`] did.
+#[derive(Clone, Debug)]
+pub enum Walled {
+    /// The point is in.
+    Inserted {
+        /// Its vertex.
+        vertex: VertexId,
+        /// The tets it replaced, for [`Delaunay::undo`].
+        change: Change,
+        /// Where point location started before.
+        last: TetId,
+    },
+    /// The point coincides with a vertex.
+    OnVertex,
+    /// The cavity would wrap around a blocked face: nothing changed.
+    Refused,
+}
+
+/// One change to the tets, as [`Delaunay::undo`] takes it back: the tets removed, with
+/// their slots and contents, and the slots of the tets that replaced them.
+#[derive(Clone, Debug, Default)]
+pub struct Change {
+    /// The removed tets: slot and contents.
+    pub old: Vec<(TetId, Tet)>,
+    /// The slots of the new tets.
+    pub new: Vec<TetId>,
+}
 
 impl Delaunay {
     /// Inserts a new point with perturbation (and output) index `pert`, which must exceed
@@ -48,6 +76,91 @@ impl Delaunay {
         Ok(Some(v))
     }
 
+    /// Inserts a Steiner point into a constrained tetrahedralization with a cavity walled
+    /// in by the `blocked` faces, unless the cavity would wrap around one of them. The
+    /// change is recorded so that [`Delaunay::undo`] can take it back.
+    pub fn insert_walled(
+        &mut self,
+        p: Point,
+        pert: u32,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<Walled, MeshError> {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Ok(Walled::Refused);
+        }
+        let v = self.points.len() as VertexId;
+        self.points.push(p);
+        self.orig.push(pert);
+        self.mesh.grow_vertices(self.points.len());
+        let found = self.blocked_cavity(v, &blocked);
+        if !matches!(found, Ok(super::Cavity::Ready)) {
+            self.points.pop();
+            self.orig.pop();
+            return match found? {
+                super::Cavity::OnVertex => Ok(Walled::OnVertex),
+                _ => Ok(Walled::Refused),
+            };
+        }
+        // What filling overwrites: the cavity's tets, whose slots the new tets reuse.
+        let old: Vec<(TetId, Tet)> = self
+            .conflict
+            .iter()
+            .map(|&t| (t, *self.mesh.tet(t)))
+            .collect();
+        let last = self.last;
+        self.fill_cavity()?;
+        let created: Vec<TetId> = self.created.iter().map(|&(t, _)| t).collect();
+        for &t in &created {
+            for &x in &self.mesh.verts(t) {
+                if x != GHOST {
+                    self.mesh.set_vertex_tet(x, t);
+                }
+            }
+        }
+        Ok(Walled::Inserted {
+            vertex: v,
+            change: Change { old, new: created },
+            last,
+        })
+    }
+
+    /// Takes back the insertion of the last vertex `v` and the changes made since (in
+    /// `changes`, oldest first, the insertion's own first), restoring the mesh exactly;
+    /// `last` is where point location started before.
+    pub fn undo(&mut self, v: VertexId, changes: &[Change], last: TetId) {
+        let mut slots: Vec<TetId> = Vec::new();
+        for c in changes.iter().rev() {
+            // The new tets' slots go first: some are the old tets' own slots.
+            for &t in &c.new {
+                self.mesh.kill_tet(t);
+            }
+            for &(t, tet) in &c.old {
+                self.mesh.restore_tet(t, tet);
+            }
+            slots.clear();
+            slots.extend(c.old.iter().map(|&(t, _)| t));
+            slots.sort_unstable();
+            for &(t, tet) in &c.old {
+                for (f, &n) in tet.adj.iter().enumerate() {
+                    if slots.binary_search(&n.tet()).is_err() {
+                        self.mesh.set_link(n, FaceRef::new(t, f));
+                    }
+                }
+                for &x in &tet.v {
+                    if x != GHOST {
+                        self.mesh.set_vertex_tet(x, t);
+                    }
+                }
+            }
+        }
+        self.created.clear();
+        self.last = last;
+        if self.points.len() == v as usize + 1 {
+            self.points.pop();
+            self.orig.pop();
+        }
+    }
+
     /// The vertices on the boundary of the cavity of the last insertion: the only
     /// vertices between which that insertion can have removed an edge.
     pub fn last_cavity_vertices(&self, out: &mut Vec<VertexId>) {
@@ -57,25 +170,6 @@ impl Delaunay {
         }
         out.sort_unstable();
         out.dedup();
-    }
-
-    /// Whether every face of the tets made by the last insertion is locally Delaunay,
-    /// except the `blocked` ones (constraints) and hull faces.
-    pub fn last_cavity_is_delaunay(&self, blocked: impl Fn([VertexId; 4], usize) -> bool) -> bool {
-        self.created.iter().all(|&(t, _)| {
-            let v = self.mesh.verts(t);
-            if v.contains(&GHOST) {
-                return true;
-            }
-            (0..4).all(|i| {
-                if blocked(v, i) {
-                    return true;
-                }
-                let n = self.mesh.adj(FaceRef::new(t, i));
-                let w = self.mesh.verts(n.tet())[n.face()];
-                w == GHOST || !self.in_sphere(t, &self.points[w as usize], w)
-            })
-        })
     }
 
     /// The internal vertex id of each of the first `n` input indices (`u32::MAX` for

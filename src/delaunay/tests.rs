@@ -1,5 +1,6 @@
 use super::*;
 use crate::geom::insphere_sos;
+use crate::mesh::Tet;
 
 use crate::geom::lcg;
 
@@ -223,4 +224,64 @@ fn location_by_scan_agrees_with_the_walk() {
         inside > 50 && outside > 50,
         "{inside} inside, {outside} outside"
     );
+}
+
+/// A walled insertion is the plain one where nothing is blocked, refuses a cavity that
+/// would reach both sides of a blocked face, and `undo` restores the mesh slot for slot.
+#[test]
+fn walled_insertions_are_undone_exactly() {
+    let pts = random_points(300, 11);
+    let mut s = 77u64;
+    for k in 0..40 {
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let before: Vec<Tet> = (0..dt.mesh.num_slots() as TetId)
+            .map(|t| *dt.mesh.tet(t))
+            .collect();
+        let tets_before = sorted_tets(&dt);
+        let p: Point = [0, 0, 0].map(|_| 0.1 + 0.8 * lcg(&mut s));
+        // Every other round, the faces of the tet holding the point are walls.
+        let holder = match dt.locate(&p) {
+            Location::Inside(t) => dt.mesh.verts(t),
+            other => panic!("{other:?}"),
+        };
+        let walls = k % 2 == 1;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            walls && {
+                let mut a = v;
+                a.sort_unstable();
+                let mut b = holder;
+                b.sort_unstable();
+                a == b && v[f] != GHOST
+            }
+        };
+        let n = dt.points.len();
+        match dt.insert_walled(p, n as u32, blocked).unwrap() {
+            Walled::Inserted {
+                vertex,
+                change,
+                last,
+            } => {
+                dt.mesh.check_links().unwrap();
+                // Walls around the holder keep every other tet: only it is replaced.
+                if walls {
+                    assert_eq!(change.old.len(), 1, "round {k}");
+                } else {
+                    let mut plain = Delaunay::build(&pts).unwrap().dt;
+                    let id = plain.points.len() as u32;
+                    plain.insert_steiner(p, id).unwrap();
+                    assert_eq!(sorted_tets(&dt), sorted_tets(&plain), "round {k}");
+                }
+                dt.undo(vertex, &[change], last);
+            }
+            other => panic!("round {k}: {other:?}"),
+        }
+        dt.mesh.check_links().unwrap();
+        assert_eq!(dt.points.len(), n);
+        assert_eq!(sorted_tets(&dt), tets_before, "round {k}");
+        for (t, tet) in before.iter().enumerate() {
+            if tet.is_real() || tet.v[3] == GHOST {
+                assert_eq!(dt.mesh.tet(t as TetId), tet, "round {k}, slot {t}");
+            }
+        }
+    }
 }

@@ -268,6 +268,17 @@ impl Mesh {
         self.free.push(t);
     }
 
+    /// Puts `tet` back in slot `t` as it was, links included, taking the slot off the
+    /// free list if it was freed (undoing an insertion).
+    pub fn restore_tet(&mut self, t: TetId, tet: Tet) {
+        if self.tets[t as usize].v[0] == DEAD {
+            if let Some(k) = self.free.iter().rposition(|&x| x == t) {
+                self.free.swap_remove(k);
+            }
+        }
+        self.tets[t as usize] = tet;
+    }
+
     /// Glues face `a` to face `b` (both directions).
     #[inline(always)]
     pub fn glue(&mut self, a: FaceRef, b: FaceRef) {

@@ -1,0 +1,185 @@
+//! The bistellar flips of a face (2-3, 3-2 and 4-4): which tets a flip replaces and by
+//! what, and the replacement itself. Shared by facet insertion by flips ([`super::flip`])
+//! and by free points, which are flipped into the CDT ([`super::free`]); each adds its
+//! own rules on which flips are allowed.
+
+use crate::error::MeshError;
+use crate::geom::{orient3d, Point};
+use crate::mesh::{FaceRef, Mesh, TetId, VertexId, FACE_VERTS, GHOST};
+
+use super::cdt::face_key;
+
+/// The kind of a flip.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// Two tets sharing a face become three around a new edge.
+    T23,
+    /// Three tets around an edge become two sharing a new face.
+    T32,
+    /// Four tets around an edge whose four other vertices are coplanar become four
+    /// around the other diagonal.
+    T44,
+}
+
+/// What flipping a face would do.
+pub(super) struct Shape {
+    /// The kind of flip.
+    pub kind: Kind,
+    /// The tets it removes.
+    pub old: Vec<TetId>,
+    /// The positively oriented tets that replace them, filling the same volume.
+    pub new: Vec<[VertexId; 4]>,
+    /// The face flipped away (2-3), or the edge removed (3-2, 4-4) with the vertices
+    /// around it: the faces `(edge, apex)` go with it.
+    pub face: [VertexId; 3],
+    pub edge: Option<([VertexId; 2], Vec<VertexId>)>,
+}
+
+/// The flip that removes face `f` (between two real tets), if the tets around it allow
+/// one: a 2-3 flip when the segment between the two apices crosses the face, a 3-2 flip
+/// when it passes beside one edge held by exactly three tets, a 4-4 flip when it meets
+/// such an edge held by four.
+pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
+    let (t1, i) = (f.tet(), f.face());
+    let g = mesh.adj(f);
+    let t2 = g.tet();
+    let v = mesh.verts(t1)[i];
+    let w = mesh.verts(t2)[g.face()];
+    let s = mesh.face_verts(t1, i);
+    let base = [s[0], s[1], s[2], v];
+    let rep = |k: usize| {
+        let mut b = base;
+        b[k] = w;
+        b
+    };
+    let orient = |t: &[VertexId; 4]| {
+        let p = t.map(|x| &pts[x as usize]);
+        orient3d(p[0], p[1], p[2], p[3])
+    };
+    let o: [f64; 3] = std::array::from_fn(|k| orient(&rep(k)));
+    let neg: Vec<usize> = (0..3).filter(|&k| o[k] < 0.0).collect();
+    let zero: Vec<usize> = (0..3).filter(|&k| o[k] == 0.0).collect();
+    // The face of `t` opposite vertex `x`.
+    let opposite = |t: TetId, x: VertexId| mesh.verts(t).iter().position(|&y| y == x);
+    if neg.is_empty() && zero.is_empty() {
+        return Some(Shape {
+            kind: Kind::T23,
+            old: vec![t1, t2],
+            new: vec![rep(0), rep(1), rep(2)],
+            face: s,
+            edge: None,
+        });
+    }
+    if neg.len() == 1 && zero.is_empty() {
+        let k = neg[0];
+        let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+        let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
+        if !mesh.verts(t3).contains(&w) {
+            return None;
+        }
+        return Some(Shape {
+            kind: Kind::T32,
+            old: vec![t1, t2, t3],
+            new: vec![rep((k + 1) % 3), rep((k + 2) % 3)],
+            face: s,
+            edge: Some(([e0, e1], vec![s[k], v, w])),
+        });
+    }
+    if zero.len() == 1 && neg.is_empty() {
+        let k = zero[0];
+        let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
+        let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
+        let t4 = mesh.adj(FaceRef::new(t2, opposite(t2, s[k])?)).tet();
+        let (t3v, t4v) = (mesh.verts(t3), mesh.verts(t4));
+        let &u = t3v.iter().find(|&&x| x != e0 && x != e1 && x != v)?;
+        if u == w || !t4v.contains(&u) || !t4v.contains(&w) {
+            return None;
+        }
+        // On u's side: t3 with e0 (then e1) replaced by w.
+        let mut new = vec![rep((k + 1) % 3), rep((k + 2) % 3)];
+        for e in [e0, e1] {
+            let mut t = t3v;
+            if let Some(p) = t.iter().position(|&x| x == e) {
+                t[p] = w;
+            }
+            if orient(&t) <= 0.0 {
+                return None;
+            }
+            new.push(t);
+        }
+        return Some(Shape {
+            kind: Kind::T44,
+            old: vec![t1, t2, t3, t4],
+            new,
+            face: s,
+            edge: Some(([e0, e1], vec![s[k], v, w, u])),
+        });
+    }
+    None
+}
+
+/// Replaces tets `old` by the positively oriented tets `new` (which fill the same
+/// volume), gluing them to each other and to the outside; `on_face` sees every face of
+/// the old tets first. Returns the new tets.
+pub(super) fn replace(
+    mesh: &mut Mesh,
+    old: &[TetId],
+    new: &[[VertexId; 4]],
+    mut on_face: impl FnMut([VertexId; 3]),
+) -> Result<Vec<TetId>, MeshError> {
+    let mut outer: Vec<([VertexId; 3], FaceRef)> = Vec::with_capacity(8);
+    for &t in old {
+        for j in 0..4 {
+            let key = face_key(mesh.face_verts(t, j));
+            let n = mesh.adj(FaceRef::new(t, j));
+            if !old.contains(&n.tet()) {
+                outer.push((key, n));
+            }
+            on_face(key);
+        }
+    }
+    for &t in old {
+        mesh.kill_tet(t);
+    }
+    let mut made = Vec::with_capacity(new.len());
+    for &v in new {
+        let t = mesh
+            .add_tet(v)
+            .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
+        made.push(t);
+    }
+    let keys: Vec<[[VertexId; 3]; 4]> = new
+        .iter()
+        .map(|v| std::array::from_fn(|j| face_key(FACE_VERTS[j].map(|x| v[x]))))
+        .collect();
+    for a in 0..made.len() {
+        'faces: for j in 0..4 {
+            for b in 0..made.len() {
+                if b == a {
+                    continue;
+                }
+                if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == keys[a][j]) {
+                    if b > a {
+                        mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
+                    }
+                    continue 'faces;
+                }
+            }
+            let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == keys[a][j]) else {
+                return Err(MeshError::Internal(format!(
+                    "a flip left face {:?} without a neighbour",
+                    keys[a][j]
+                )));
+            };
+            mesh.glue(FaceRef::new(made[a], j), n);
+        }
+    }
+    for &t in &made {
+        for x in mesh.verts(t) {
+            if x != GHOST {
+                mesh.set_vertex_tet(x, t);
+            }
+        }
+    }
+    Ok(made)
+}
