@@ -14,6 +14,16 @@ use rustc_hash::FxHashMap;
 /// Flips per inserted point beyond which the point is taken back.
 const MAX_FLIPS: usize = 20_000;
 
+/// The vertices joined to each vertex by a subsegment: what [`insert_point`] checks.
+pub(super) fn subsegment_ends(cdt: &Cdt) -> FxHashMap<VertexId, Vec<VertexId>> {
+    let mut at: FxHashMap<VertexId, Vec<VertexId>> = FxHashMap::default();
+    for &(a, b) in cdt.subsegs.keys() {
+        at.entry(a).or_default().push(b);
+        at.entry(b).or_default().push(a);
+    }
+    at
+}
+
 /// Inserts free points into the CDT, one from each list of candidates (the first that
 /// fits), and returns how many it added and the first candidates of the lists it left
 /// out (whose every candidate would break the CDT; the CDT then stays as it was).
@@ -22,23 +32,19 @@ pub(super) fn insert_free(
     free: &[Vec<Point>],
     next_pert: &mut u32,
 ) -> Result<(usize, Vec<Point>), MeshError> {
-    let mut at: FxHashMap<VertexId, Vec<VertexId>> = FxHashMap::default();
-    for &(a, b) in cdt.subsegs.keys() {
-        at.entry(a).or_default().push(b);
-        at.entry(b).or_default().push(a);
-    }
+    let at = subsegment_ends(cdt);
     let mut added = 0;
     let mut refused = Vec::new();
     'tets: for ws in free {
         for &w in ws {
-            match insert_one(cdt, w, *next_pert, &at)? {
-                Some(true) => {
+            match insert_point(cdt, w, *next_pert, &at)? {
+                Inserted::Yes { .. } => {
                     *next_pert += 1;
                     added += 1;
                     continue 'tets;
                 }
-                Some(false) => {}
-                None => continue 'tets,
+                Inserted::Refused => {}
+                Inserted::OnVertex => continue 'tets,
             }
         }
         refused.extend(ws.first());
@@ -46,35 +52,67 @@ pub(super) fn insert_free(
     Ok((added, refused))
 }
 
-/// Inserts one free point: `Some(true)` if in, `Some(false)` if taken back or refused,
-/// `None` if it coincides with a vertex.
-fn insert_one(
+/// What [`insert_point`] did.
+pub(super) enum Inserted {
+    /// The point is in as `vertex`; [`take_back`] undoes it while nothing else changed.
+    Yes {
+        vertex: VertexId,
+        changes: Vec<Change>,
+        last: TetId,
+    },
+    /// It would break the CDT: nothing changed.
+    Refused,
+    /// It coincides with a vertex: nothing changed.
+    OnVertex,
+}
+
+/// Inserts point `w` (perturbation index `pert`) into the CDT: a cavity walled in by the
+/// subfaces, then flips until every face is locally Delaunay again. Refused, leaving
+/// the CDT as it was, if the flips cannot get there or a subsegment (`at`, from
+/// [`subsegment_ends`]) would be lost.
+pub(super) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
     pert: u32,
     at: &FxHashMap<VertexId, Vec<VertexId>>,
-) -> Result<Option<bool>, MeshError> {
+) -> Result<Inserted, MeshError> {
     let subfaces = &cdt.subfaces;
     let blocked = |v: [VertexId; 4], f: usize| {
         let fv = FACE_VERTS[f];
         subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
     };
-    let (v, first, last) = match cdt.dt.insert_walled(w, pert, blocked)? {
+    let (vertex, first, last) = match cdt.dt.insert_walled(w, pert, blocked)? {
         Walled::Inserted {
             vertex,
             change,
             last,
         } => (vertex, change, last),
-        Walled::OnVertex => return Ok(None),
-        Walled::Refused => return Ok(Some(false)),
+        Walled::OnVertex => return Ok(Inserted::OnVertex),
+        Walled::Refused => return Ok(Inserted::Refused),
     };
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
     if settled && keeps_subsegments(cdt, &changes, at) {
-        return Ok(Some(true));
+        return Ok(Inserted::Yes {
+            vertex,
+            changes,
+            last,
+        });
     }
-    cdt.dt.undo(v, &changes, last);
-    Ok(Some(false))
+    cdt.dt.undo(vertex, &changes, last);
+    Ok(Inserted::Refused)
+}
+
+/// Takes back a point that [`insert_point`] put in, if nothing has changed since.
+pub(super) fn take_back(cdt: &mut Cdt, inserted: Inserted) {
+    if let Inserted::Yes {
+        vertex,
+        changes,
+        last,
+    } = inserted
+    {
+        cdt.dt.undo(vertex, &changes, last);
+    }
 }
 
 /// Flips the faces of the tets made so far (`changes`) that are not locally Delaunay

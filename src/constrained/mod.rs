@@ -318,7 +318,7 @@ pub fn mesh_plc_with_progress(
         match outcome {
             Attempt::Done(built) => {
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
-                stats.facet_steiner_points = facet_points.len() - free;
+                stats.facet_steiner_points += facet_points.len() - free;
                 stats.free_steiner_points += free;
                 let (mesh, more) = finish(plc, prep, *built, opts, &mut stats, progress)?;
                 warnings.extend(more);
@@ -491,6 +491,10 @@ fn attempt(
     let mut steiner_facets: FxHashSet<usize> = FxHashSet::default();
     let mut rounds = 0usize;
     let max_rounds = 20 * prep.facets.len() + 1000;
+    // Steiner points put on facets in this attempt, and the subsegments' ends they check.
+    let mut placed_on_facets = 0usize;
+    let mut ends = None;
+    stats.facet_steiner_points = 0;
     while let Some(fi) = queue.pop() {
         opts.check_cancel()?;
         queued[fi] = false;
@@ -519,6 +523,7 @@ fn attempt(
                 missing.push(*t);
             }
         }
+        let mut retriangulated = None;
         for region in regions_of(&missing, &seg_markers) {
             let fallbacks = stats.flips.fallbacks;
             let outcome =
@@ -547,6 +552,53 @@ fn attempt(
                     if debug() {
                         eprintln!("facet {fi}: Steiner point {p:?}");
                     }
+                    // The point goes straight into the CDT, and the facet is triangulated
+                    // again with it, if its triangles already in the mesh keep their
+                    // place; otherwise the construction starts again with it.
+                    let room = stats.steiner_points < opts.max_steiner
+                        && placed_on_facets < max_facet_points(plc);
+                    if room {
+                        let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
+                        let inserted = free::insert_point(&mut cdt, p, next_pert, at)?;
+                        if let free::Inserted::Yes { vertex, .. } = inserted {
+                            extra[fi].push(vertex);
+                            let ctx = FacetContext {
+                                plc,
+                                prep,
+                                points: &cdt.dt.points,
+                                orig: &cdt.dt.orig,
+                                inv: &inv,
+                                seg_index: &seg_index,
+                                subsegs: &subsegs,
+                                extra: &extra,
+                            };
+                            let again = ctx.triangles(fi);
+                            if let Ok(Some(new)) = &again {
+                                let keys: FxHashSet<[VertexId; 3]> =
+                                    new.iter().map(|t| face_key(*t)).collect();
+                                let kept = tris.iter().map(|t| face_key(*t)).all(|k| {
+                                    cdt.subfaces.get(&k) != Some(&(fi as u32)) || keys.contains(&k)
+                                });
+                                if kept {
+                                    retriangulated = Some(again);
+                                    next_pert += 1;
+                                    placed_on_facets += 1;
+                                    stats.steiner_points += 1;
+                                    stats.facet_steiner_points += 1;
+                                    queued[fi] = true;
+                                    queue.push(fi);
+                                    break;
+                                }
+                            }
+                            if debug() {
+                                eprintln!("facet {fi}: its triangles would move with the point");
+                            }
+                            extra[fi].pop();
+                            free::take_back(&mut cdt, inserted);
+                        } else if debug() {
+                            eprintln!("facet {fi}: the CDT refuses the point");
+                        }
+                    }
                     steiner.push((fi, p));
                     steiner_facets.insert(fi);
                     break;
@@ -562,6 +614,9 @@ fn attempt(
                 }
             }
         }
+        if let Some(again) = retriangulated {
+            facet_tris[fi] = again;
+        }
     }
     stats.facet_secs = t2.elapsed().as_secs_f64();
     stats.crossing_tests += cdt.crossing_tests.get();
@@ -572,6 +627,7 @@ fn attempt(
         steiner.extend(more);
         carved = c;
     }
+
     stats.free_steiner_points = 0;
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
         let domain = slivers::Domain {
@@ -635,6 +691,7 @@ fn attempt(
             break;
         }
         stats.steiner_points += stats.free_steiner_points;
+
         // A flat tet whose circumsphere lies within its facet's slab spans a gap between
         // segments closer than the slab is thick. Its size, not its shape, makes it flat:
         // splitting its longest subsegment makes the tets there smaller against the gap.

@@ -98,6 +98,18 @@ pub(crate) fn free_points(
     if flat_tets.is_empty() {
         return FlatTets::default();
     }
+    // Only kept tets matter, and the carving is needed anyway (the output reuses it):
+    // flat tets outside the domain, often many, are dropped before any facet is looked at.
+    let kept = carved
+        .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
+        .kept_mask(cdt.dt.mesh.num_slots());
+    let flat_tets: Vec<crate::mesh::TetId> = flat_tets
+        .into_iter()
+        .filter(|&t| kept[t as usize])
+        .collect();
+    if flat_tets.is_empty() {
+        return FlatTets::default();
+    }
     let diag = diagonal(input);
     // Which facets each input vertex is on, as lists per vertex (one flat array).
     let ring_verts = |f: &super::prepare::MergedFacet| -> Vec<u32> {
@@ -187,14 +199,8 @@ pub(crate) fn free_points(
     }
     // A free point must leave every facet's slab: all are needed from here on.
     let slabs: Vec<Option<Slab>> = (0..prep.facets.len() as u32).map(&mut slab_at).collect();
-    let kept = carved
-        .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
-        .kept_mask(cdt.dt.mesh.num_slots());
     let mut out = FlatTets::default();
     for (t, f) in flat {
-        if !kept[t as usize] {
-            continue;
-        }
         let Some(slab) = slabs[f as usize].as_ref() else {
             continue;
         };
