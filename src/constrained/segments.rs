@@ -122,7 +122,8 @@ pub fn recover_segments(
     // Recovered pieces are indexed by both endpoints: an insertion can only remove
     // edges between vertices of its cavity, so only those pieces are checked again.
     let mut scratch = Vec::new();
-    let mut cavity = Vec::new();
+    // The last insertion's cavity: its vertices, and a stamp per vertex for membership.
+    let mut cavity = Cavity::default();
     // Vertices of some insertion's cavity: an edge between two untouched vertices that
     // was in the mesh at the start still is.
     let mut touched = vec![false; dt.points.len()];
@@ -164,27 +165,38 @@ pub fn recover_segments(
             *next_pert += 1;
             steiner += 1;
             splits[pc.seg].push((s, w));
-            dt.last_cavity_vertices(&mut cavity);
-            for &x in &cavity {
+            cavity.of_last_insertion(dt);
+            for &x in &cavity.verts {
                 if let Some(t) = touched.get_mut(x as usize) {
                     *t = true;
                 }
             }
             done.recheck(dt, &cavity, w, &mut queue, &mut scratch);
-            queue.push(Piece {
-                seg: pc.seg,
-                s0: pc.s0,
-                u: pc.u,
-                s1: s,
-                v: w,
-            });
-            queue.push(Piece {
-                seg: pc.seg,
-                s0: s,
-                u: w,
-                s1: pc.s1,
-                v: pc.v,
-            });
+            // Every cavity vertex is joined to the new one: a half whose other end is
+            // one is an edge now, and is recovered without a look at the mesh.
+            let halves = [
+                Piece {
+                    seg: pc.seg,
+                    s0: pc.s0,
+                    u: pc.u,
+                    s1: s,
+                    v: w,
+                },
+                Piece {
+                    seg: pc.seg,
+                    s0: s,
+                    u: w,
+                    s1: pc.s1,
+                    v: pc.v,
+                },
+            ];
+            for (half, end) in halves.into_iter().zip([pc.u, pc.v]) {
+                if cavity.holds(end) {
+                    done.push(half);
+                } else {
+                    queue.push(half);
+                }
+            }
         }
         // A last full check, in case a piece was lost without a recorded cavity (none
         // can be if nothing was inserted).
@@ -236,7 +248,7 @@ impl Recovered {
     fn recheck(
         &mut self,
         dt: &Delaunay,
-        cavity: &[VertexId],
+        cavity: &Cavity,
         new: VertexId,
         queue: &mut Vec<Piece>,
         scratch: &mut Vec<crate::mesh::TetId>,
@@ -251,7 +263,7 @@ impl Recovered {
             }
             at
         });
-        for &x in cavity {
+        for &x in &cavity.verts {
             if x == new {
                 continue;
             }
@@ -263,10 +275,10 @@ impl Recovered {
                 let Some(pc) = self.pieces[i] else { continue };
                 let other = if pc.u == x { pc.v } else { pc.u };
                 // Each piece is seen from both ends; check it from the lower one.
-                if other < x && cavity.binary_search(&other).is_ok() {
+                if other < x && cavity.holds(other) {
                     continue;
                 }
-                if cavity.binary_search(&other).is_ok() && !edge_between(dt, pc.u, pc.v, scratch) {
+                if cavity.holds(other) && !cavity.keeps_edge(dt, pc.u, pc.v, scratch) {
                     self.pieces[i] = None;
                     queue.push(pc);
                 }
@@ -300,6 +312,69 @@ impl Recovered {
                 }
             }
         }
+    }
+}
+
+/// The vertices of the last insertion's cavity, each once, with a stamp per vertex for
+/// membership (sorting them cost more than the insertion's other bookkeeping).
+#[derive(Default)]
+struct Cavity {
+    verts: Vec<VertexId>,
+    /// The edges of the cavity's boundary faces: edges of the new tets, so still there.
+    rim: rustc_hash::FxHashSet<(VertexId, VertexId)>,
+    stamp: Vec<u32>,
+    now: u32,
+    /// The vertices with repeats, as the mesh gives them (a buffer kept between uses).
+    spare: Vec<VertexId>,
+}
+
+impl Cavity {
+    /// Takes the cavity of `dt`'s last insertion.
+    fn of_last_insertion(&mut self, dt: &Delaunay) {
+        self.now = self.now.wrapping_add(1);
+        if self.now == 0 {
+            self.stamp.iter_mut().for_each(|x| *x = 0);
+            self.now = 1;
+        }
+        if self.stamp.len() < dt.points.len() {
+            self.stamp.resize(dt.points.len(), 0);
+        }
+        let mut all = std::mem::take(&mut self.spare);
+        dt.last_cavity_vertices_unsorted(&mut all);
+        self.verts.clear();
+        for &x in &all {
+            if self.stamp[x as usize] != self.now {
+                self.stamp[x as usize] = self.now;
+                self.verts.push(x);
+            }
+        }
+        self.spare = all;
+        self.rim.clear();
+        for &(t, f) in dt.last_created() {
+            let v = dt.mesh.face_verts(t, f);
+            if !v.contains(&crate::mesh::GHOST) {
+                for k in 0..3 {
+                    self.rim.insert(edge_key(v[k], v[(k + 1) % 3]));
+                }
+            }
+        }
+    }
+
+    /// Is `a`–`b`, between two vertices of the cavity, a mesh edge? Edges of the
+    /// boundary faces are; others are looked for around the newer vertex.
+    fn keeps_edge(
+        &self,
+        dt: &Delaunay,
+        a: VertexId,
+        b: VertexId,
+        scratch: &mut Vec<crate::mesh::TetId>,
+    ) -> bool {
+        self.rim.contains(&edge_key(a, b)) || edge_between(dt, a, b, scratch)
+    }
+
+    /// Is `v` a vertex of the cavity?
+    fn holds(&self, v: VertexId) -> bool {
+        self.stamp.get(v as usize) == Some(&self.now)
     }
 }
 

@@ -164,12 +164,23 @@ impl Delaunay {
     /// The vertices on the boundary of the cavity of the last insertion: the only
     /// vertices between which that insertion can have removed an edge.
     pub fn last_cavity_vertices(&self, out: &mut Vec<VertexId>) {
+        self.last_cavity_vertices_unsorted(out);
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    /// The tets made by the last insertion, each with its face opposite the new vertex
+    /// (a face of the cavity's boundary).
+    pub fn last_created(&self) -> &[(TetId, usize)] {
+        &self.created
+    }
+
+    /// [`Delaunay::last_cavity_vertices`] in no order, with repeats.
+    pub fn last_cavity_vertices_unsorted(&self, out: &mut Vec<VertexId>) {
         out.clear();
         for &(t, _) in &self.created {
             out.extend(self.mesh.verts(t).iter().filter(|&&x| x != GHOST));
         }
-        out.sort_unstable();
-        out.dedup();
     }
 
     /// The internal vertex id of each of the first `n` input indices (`u32::MAX` for
