@@ -2,9 +2,10 @@
 //! recovery with Steiner points, and facet insertion, then carving.
 //!
 //! [`mesh_plc`] runs read PLC → Delaunay → segments → facets → carve. When a polygon
-//! that is not flat needs a Steiner point on it (paper §3.1), the point is added to the
-//! facet and the whole construction starts again from the Delaunay tetrahedralization:
-//! simple to get right, and rare in practice.
+//! that is not flat needs a Steiner point on it (paper §3.1), the point goes into the
+//! CDT by a walled cavity and flips (`free.rs`) and the polygon is triangulated again
+//! with it; where that cannot be done, the point is added to the facet and the whole
+//! construction starts again from the Delaunay tetrahedralization.
 
 mod bistellar;
 pub mod cavity;
