@@ -199,6 +199,11 @@ const RESTART_WORK: u64 = 20_000_000;
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
 const MAX_FREE_ROUNDS: usize = 12;
 
+/// Restarts after which free points the CDT refuses and flat-tet splits no longer start
+/// the construction again: each costs a whole construction, and past a few they do not
+/// converge (on fans of needle triangles every restart finds new flat tets).
+const MAX_FREE_RESTARTS: usize = 3;
+
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
     mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
@@ -447,8 +452,11 @@ fn attempt(
             }
         });
     }
-    let mut seg_markers = FxHashMap::default();
-    let mut seg_of: FxHashMap<(VertexId, VertexId), usize> = FxHashMap::default();
+    // Sized up front: growing maps of this many entries rehashes them over and over.
+    let pieces: usize = subsegs.chains.iter().map(|c| c.len() - 1).sum();
+    let mut seg_markers = FxHashMap::with_capacity_and_hasher(pieces, rustc_hash::FxBuildHasher);
+    let mut seg_of: FxHashMap<(VertexId, VertexId), usize> =
+        FxHashMap::with_capacity_and_hasher(pieces, rustc_hash::FxBuildHasher);
     for (i, chain) in subsegs.chains.iter().enumerate() {
         for w in chain.windows(2) {
             seg_markers.insert(edge_key(w[0], w[1]), seg_marker[i].unwrap_or(0));
@@ -483,6 +491,7 @@ fn attempt(
         .collect();
     let mut cdt = Cdt::new(dt);
     cdt.index_faces_of(&wanted);
+    cdt.subfaces.reserve(wanted.len());
     let mut splits: Vec<(usize, f64)> = Vec::new();
     cdt.subsegs = seg_markers.clone();
     let mut queue: Vec<usize> = (0..prep.facets.len()).collect();
@@ -686,7 +695,7 @@ fn attempt(
                 .iter()
                 .filter(|p| !facet_points.iter().any(|(_, q)| q == *p))
                 .map(|&p| (FREE_POINT, p));
-            if stats.restarts + 1 < MAX_FREE_ROUNDS && stats.crossing_tests < RESTART_WORK / 4 {
+            if stats.restarts < MAX_FREE_RESTARTS && stats.crossing_tests < RESTART_WORK / 4 {
                 steiner.extend(new);
             }
             break;
@@ -698,7 +707,7 @@ fn attempt(
         // splitting its longest subsegment makes the tets there smaller against the gap.
         // Like free points, they only improve a valid CDT: only while the restart they
         // cost stays well within the bounds on restarts and their work.
-        let affordable = stats.restarts + 1 < MAX_FREE_ROUNDS
+        let affordable = stats.restarts < MAX_FREE_RESTARTS
             && stats.crossing_tests < RESTART_WORK / 4
             && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
         if steiner.is_empty() && affordable {

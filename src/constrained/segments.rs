@@ -171,7 +171,7 @@ pub fn recover_segments(
                     *t = true;
                 }
             }
-            done.recheck(dt, &cavity, w, &mut queue, &mut scratch);
+            done.recheck(dt, &mut cavity, w, &mut queue, &mut scratch);
             // Every cavity vertex is joined to the new one: a half whose other end is
             // one is an edge now, and is recovered without a look at the mesh.
             let halves = [
@@ -248,7 +248,7 @@ impl Recovered {
     fn recheck(
         &mut self,
         dt: &Delaunay,
-        cavity: &Cavity,
+        cavity: &mut Cavity,
         new: VertexId,
         queue: &mut Vec<Piece>,
         scratch: &mut Vec<crate::mesh::TetId>,
@@ -263,7 +263,8 @@ impl Recovered {
             }
             at
         });
-        for &x in &cavity.verts {
+        for k in 0..cavity.verts.len() {
+            let x = cavity.verts[k];
             if x == new {
                 continue;
             }
@@ -321,7 +322,9 @@ impl Recovered {
 struct Cavity {
     verts: Vec<VertexId>,
     /// The edges of the cavity's boundary faces: edges of the new tets, so still there.
+    /// Made on the first question: most insertions have no recovered piece to check.
     rim: rustc_hash::FxHashSet<(VertexId, VertexId)>,
+    rim_made: bool,
     stamp: Vec<u32>,
     now: u32,
     /// The vertices with repeats, as the mesh gives them (a buffer kept between uses).
@@ -349,26 +352,30 @@ impl Cavity {
             }
         }
         self.spare = all;
-        self.rim.clear();
-        for &(t, f) in dt.last_created() {
-            let v = dt.mesh.face_verts(t, f);
-            if !v.contains(&crate::mesh::GHOST) {
-                for k in 0..3 {
-                    self.rim.insert(edge_key(v[k], v[(k + 1) % 3]));
-                }
-            }
-        }
+        self.rim_made = false;
     }
 
     /// Is `a`–`b`, between two vertices of the cavity, a mesh edge? Edges of the
     /// boundary faces are; others are looked for around the newer vertex.
     fn keeps_edge(
-        &self,
+        &mut self,
         dt: &Delaunay,
         a: VertexId,
         b: VertexId,
         scratch: &mut Vec<crate::mesh::TetId>,
     ) -> bool {
+        if !self.rim_made {
+            self.rim_made = true;
+            self.rim.clear();
+            for &(t, f) in dt.last_created() {
+                let v = dt.mesh.face_verts(t, f);
+                if !v.contains(&crate::mesh::GHOST) {
+                    for k in 0..3 {
+                        self.rim.insert(edge_key(v[k], v[(k + 1) % 3]));
+                    }
+                }
+            }
+        }
         self.rim.contains(&edge_key(a, b)) || edge_between(dt, a, b, scratch)
     }
 
