@@ -1,7 +1,8 @@
-//! Free Steiner points (inside the domain, on no constraint) put into a finished CDT: a
-//! cavity walled in by the subfaces, then flips of the faces that are not locally
-//! Delaunay, as TetGen does. A point that the flips cannot settle, or that would remove
-//! a subsegment, is taken back, leaving the CDT exactly as it was.
+//! Points put into a finished CDT (free Steiner points inside the domain, and Steiner
+//! points on polygons that are not flat): a cavity walled in by the subfaces, then flips
+//! of the faces that are not locally Delaunay, as TetGen does. A point that the flips
+//! cannot settle, or that would remove a subsegment, is taken back, leaving the CDT
+//! exactly as it was.
 
 use super::bistellar;
 use super::cdt::{edge_key, face_key, Cdt};

@@ -645,8 +645,8 @@ fn attempt(
             regions: &plc.regions,
             keep_hull: opts.keep_hull,
         };
-        // Free points go straight into the CDT, round after round; only if one cannot
-        // (its cavity would cross a constraint) does the construction start again with it.
+        // Free points go straight into the CDT (`free.rs`), round after round; only if
+        // none of a round's can does the construction start again with them.
         // The input ends of the segment of each Steiner point on one, which name the
         // facets a flat tet of such points may lie on.
         let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
