@@ -85,12 +85,15 @@ pub fn insert_region(
         };
     }
     let crossing = cavity.len();
-    let mut in_cav: FxHashSet<TetId> = cavity.iter().copied().collect();
+    let mut in_cav = SlotSet::new(cdt.dt.mesh.num_slots());
+    for &t in &cavity {
+        in_cav.insert(t);
+    }
     let mut enlarged = 0;
     let mut bubbles = Vec::new();
     let (mut top, mut bottom) = loop {
         bubbles.clear();
-        if let Some(sides) = split_sides(cdt, &region, &in_cav, &mut bubbles)? {
+        if let Some(sides) = split_sides(cdt, &region, &cavity, &in_cav, &mut bubbles)? {
             break sides;
         }
         if bubbles.is_empty() {
@@ -434,10 +437,64 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
         .any(|&(i, j)| region.crossed_by(&cdt.dt.points, v[i], v[j]))
 }
 
+/// A set of tets as a stamp per slot, in arrays kept from one region to the next: a
+/// hash set per region cost more than the region's own cavity work.
+pub(crate) struct SlotSet {
+    stamp: Vec<u32>,
+    now: u32,
+}
+
+thread_local! {
+    static SLOT_SETS: std::cell::RefCell<Vec<(Vec<u32>, u32)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+impl SlotSet {
+    /// An empty set for a mesh of `slots` tet slots (more may be added).
+    pub(crate) fn new(slots: usize) -> Self {
+        let (mut stamp, mut now) = SLOT_SETS.with(|p| p.borrow_mut().pop()).unwrap_or_default();
+        now = now.wrapping_add(1);
+        if now == 0 {
+            stamp.iter_mut().for_each(|x| *x = 0);
+            now = 1;
+        }
+        if stamp.len() < slots {
+            stamp.resize(slots, 0);
+        }
+        SlotSet { stamp, now }
+    }
+
+    /// Is tet `t` in the set?
+    #[inline]
+    pub(crate) fn contains(&self, t: &TetId) -> bool {
+        self.stamp.get(*t as usize) == Some(&self.now)
+    }
+
+    /// Adds tet `t`; false if it was there already.
+    #[inline]
+    pub(crate) fn insert(&mut self, t: TetId) -> bool {
+        let i = t as usize;
+        if i >= self.stamp.len() {
+            self.stamp.resize(i + 1, 0);
+        }
+        let fresh = self.stamp[i] != self.now;
+        self.stamp[i] = self.now;
+        fresh
+    }
+}
+
+impl Drop for SlotSet {
+    fn drop(&mut self) {
+        let stamp = std::mem::take(&mut self.stamp);
+        let now = self.now;
+        SLOT_SETS.with(|p| p.borrow_mut().push((stamp, now)));
+    }
+}
+
 /// The tets whose interiors meet the region: those with an edge crossing it. They are
 /// face-connected, and each touches the region near a region vertex or is reached from one.
 pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
-    let mut seen: FxHashSet<TetId> = FxHashSet::default();
+    let mut seen = SlotSet::new(cdt.dt.mesh.num_slots());
     let mut out = Vec::new();
     let mut star = Vec::new();
     let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
@@ -470,13 +527,14 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
 fn split_sides(
     cdt: &Cdt,
     region: &Region,
-    in_cav: &FxHashSet<TetId>,
+    cavity: &[TetId],
+    in_cav: &SlotSet,
     bubbles: &mut Vec<FaceRef>,
 ) -> Result<Option<Sides>, MeshError> {
     let mesh = &cdt.dt.mesh;
     let mut faces: Vec<FaceRef> = Vec::new();
     let mut index: FxHashMap<FaceRef, usize> = FxHashMap::default();
-    let mut cav: Vec<TetId> = in_cav.iter().copied().collect();
+    let mut cav: Vec<TetId> = cavity.to_vec();
     cav.sort_unstable();
     for &t in &cav {
         for i in 0..4 {
@@ -583,7 +641,7 @@ fn surface_neighbor(
     f: FaceRef,
     a: VertexId,
     b: VertexId,
-    in_cav: &FxHashSet<TetId>,
+    in_cav: &SlotSet,
 ) -> Result<FaceRef, MeshError> {
     let mesh = &cdt.dt.mesh;
     let mut g = mesh.adj(f);
@@ -779,7 +837,7 @@ fn grow(
     cdt: &Cdt,
     t: TetId,
     side: usize,
-    in_cav: &mut FxHashSet<TetId>,
+    in_cav: &mut SlotSet,
     top: &mut Vec<CavFace>,
     bottom: &mut Vec<CavFace>,
 ) -> Result<(), MeshError> {
