@@ -20,7 +20,7 @@
 //! algorithm does.
 
 use super::bistellar::{self, Kind};
-use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
+use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats, SlotSet};
 use super::cdt::{edge_key, face_key, Cdt};
 use crate::error::MeshError;
 use crate::geom::lifted::{
@@ -247,15 +247,14 @@ fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
     [a, b, c]
 }
 
-/// Scratch arrays indexed by vertex and tet id, valid where their stamp is the current
-/// one: per-region hash maps cost more than the flips themselves, and clearing arrays
-/// the size of the mesh for every region would cost more still.
+/// Scratch arrays indexed by vertex id, valid where their stamp is the current one:
+/// per-region hash maps cost more than the flips themselves, and clearing arrays the
+/// size of the mesh for every region would cost more still (tets: a [`SlotSet`]).
 #[derive(Default)]
 struct Marks {
     stamp: u32,
     vert_stamp: Vec<u32>,
     vert: Vec<(i8, Approx)>,
-    tet_stamp: Vec<u32>,
 }
 
 thread_local! {
@@ -264,19 +263,15 @@ thread_local! {
 
 impl Marks {
     /// Starts a region: a fresh stamp, arrays large enough for the mesh.
-    fn next_stamp(&mut self, verts: usize, tets: usize) {
+    fn next_stamp(&mut self, verts: usize) {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.vert_stamp.iter_mut().for_each(|x| *x = 0);
-            self.tet_stamp.iter_mut().for_each(|x| *x = 0);
             self.stamp = 1;
         }
         if self.vert_stamp.len() < verts {
             self.vert_stamp.resize(verts, 0);
             self.vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
-        }
-        if self.tet_stamp.len() < tets {
-            self.tet_stamp.resize(tets, 0);
         }
     }
 
@@ -288,24 +283,6 @@ impl Marks {
     fn set_side(&mut self, v: VertexId, side: i8, h: Approx) {
         self.vert_stamp[v as usize] = self.stamp;
         self.vert[v as usize] = (side, h);
-    }
-
-    #[inline]
-    fn has_tet(&self, t: TetId) -> bool {
-        self.tet_stamp.get(t as usize) == Some(&self.stamp)
-    }
-
-    fn add_tet(&mut self, t: TetId) {
-        if self.tet_stamp.len() <= t as usize {
-            self.tet_stamp.resize(t as usize + 1, 0);
-        }
-        self.tet_stamp[t as usize] = self.stamp;
-    }
-
-    fn remove_tet(&mut self, t: TetId) {
-        if let Some(x) = self.tet_stamp.get_mut(t as usize) {
-            *x = 0;
-        }
     }
 }
 
@@ -332,9 +309,10 @@ struct Flipper<'a> {
     cdt: &'a mut Cdt,
     region: &'a Region,
     lift: Lifting,
-    /// Per-vertex sides and heights, and the membership of tets in R (they change as
-    /// flips replace them), in arrays stamped for this region.
+    /// Per-vertex sides and heights, in arrays stamped for this region.
     marks: Marks,
+    /// The tets in R (they change as flips replace them).
+    in_r: SlotSet,
     /// The tets put in R (some since flipped away: filter with `in_r`).
     r_list: Vec<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
@@ -360,9 +338,10 @@ struct Flipper<'a> {
 impl<'a> Flipper<'a> {
     fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
         let mut marks = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
-        marks.next_stamp(cdt.dt.points.len(), cdt.dt.mesh.num_slots());
+        marks.next_stamp(cdt.dt.points.len());
+        let mut in_r = SlotSet::new(cdt.dt.mesh.num_slots());
         for &t in crossing {
-            marks.add_tet(t);
+            in_r.insert(t);
             for v in cdt.dt.mesh.verts(t) {
                 if marks.side(v).is_none() {
                     let p = &cdt.dt.points[v as usize];
@@ -380,6 +359,7 @@ impl<'a> Flipper<'a> {
             region,
             lift,
             marks,
+            in_r,
             r_list: crossing.to_vec(),
             region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
             events: Vec::new(),
@@ -536,7 +516,7 @@ impl<'a> Flipper<'a> {
     /// Is tet `t` in R?
     #[inline]
     fn in_r(&self, t: TetId) -> bool {
-        self.marks.has_tet(t)
+        self.in_r.contains(&t)
     }
 
     /// The tets of R now, without repeats.
@@ -746,10 +726,10 @@ impl<'a> Flipper<'a> {
             }
         })?;
         for &t in old {
-            self.marks.remove_tet(t);
+            self.in_r.remove(t);
         }
         for &t in &made {
-            self.marks.add_tet(t);
+            self.in_r.insert(t);
             self.r_list.push(t);
         }
         Ok(made)

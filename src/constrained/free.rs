@@ -9,20 +9,15 @@ use super::cdt::{edge_key, face_key, Cdt};
 use crate::delaunay::{Change, Walled};
 use crate::error::MeshError;
 use crate::geom::{insphere_sos, Point, Sign};
-use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
-use rustc_hash::FxHashMap;
+use crate::mesh::{FaceRef, TetId, VertexId, VertexLists, FACE_VERTS};
 
 /// Flips per inserted point beyond which the point is taken back.
 const MAX_FLIPS: usize = 20_000;
 
 /// The vertices joined to each vertex by a subsegment: what [`insert_point`] checks.
-pub(super) fn subsegment_ends(cdt: &Cdt) -> FxHashMap<VertexId, Vec<VertexId>> {
-    let mut at: FxHashMap<VertexId, Vec<VertexId>> = FxHashMap::default();
-    for &(a, b) in cdt.subsegs.keys() {
-        at.entry(a).or_default().push(b);
-        at.entry(b).or_default().push(a);
-    }
-    at
+pub(super) fn subsegment_ends(cdt: &Cdt) -> VertexLists<VertexId> {
+    let ends = cdt.subsegs.keys().flat_map(|&(a, b)| [(a, b), (b, a)]);
+    VertexLists::new(cdt.dt.points.len(), ends)
 }
 
 /// Inserts free points into the CDT, one from each list of candidates (the first that
@@ -75,7 +70,7 @@ pub(super) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
     pert: u32,
-    at: &FxHashMap<VertexId, Vec<VertexId>>,
+    at: &VertexLists<VertexId>,
 ) -> Result<Inserted, MeshError> {
     let subfaces = &cdt.subfaces;
     let blocked = |v: [VertexId; 4], f: usize| {
@@ -187,11 +182,7 @@ fn not_delaunay(cdt: &Cdt, f: FaceRef) -> bool {
 
 /// Are the subsegments between vertices of the changed tets still mesh edges? Only
 /// those can have gone.
-fn keeps_subsegments(
-    cdt: &mut Cdt,
-    changes: &[Change],
-    at: &FxHashMap<VertexId, Vec<VertexId>>,
-) -> bool {
+fn keeps_subsegments(cdt: &mut Cdt, changes: &[Change], at: &VertexLists<VertexId>) -> bool {
     let mut verts: Vec<VertexId> = changes
         .iter()
         .flat_map(|c| c.old.iter().flat_map(|(_, tet)| tet.v))
@@ -199,9 +190,7 @@ fn keeps_subsegments(
     verts.sort_unstable();
     verts.dedup();
     verts.iter().all(|&x| {
-        at.get(&x)
-            .map(|v| v.as_slice())
-            .unwrap_or(&[])
+        at.of(x)
             .iter()
             .all(|&y| x > y || verts.binary_search(&y).is_err() || cdt.has_edge(x, y))
     })

@@ -343,7 +343,7 @@ impl Cavity {
             self.stamp.resize(dt.points.len(), 0);
         }
         let mut all = std::mem::take(&mut self.spare);
-        dt.last_cavity_vertices_unsorted(&mut all);
+        dt.last_cavity_vertices(&mut all);
         self.verts.clear();
         for &x in &all {
             if self.stamp[x as usize] != self.now {

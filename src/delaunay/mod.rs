@@ -404,19 +404,9 @@ impl Delaunay {
     /// Inserts vertex `pv` (already in `points`). Returns `Ok(false)` if it coincides with
     /// an existing vertex and was skipped.
     pub fn insert(&mut self, pv: VertexId) -> Result<bool, MeshError> {
-        self.insert_blocked(pv, |_, _| false)
-    }
-
-    /// [`Delaunay::insert`] whose cavity never grows across a face for which
-    /// `blocked(tet's vertices, face index)` holds: inserting a vertex into a constrained
-    /// Delaunay tetrahedralization, where the constraints hide what lies behind them.
-    pub fn insert_blocked(
-        &mut self,
-        pv: VertexId,
-        blocked: impl Fn([VertexId; 4], usize) -> bool,
-    ) -> Result<bool, MeshError> {
-        match self.blocked_cavity(pv, blocked)? {
+        match self.blocked_cavity(pv, |_, _| false)? {
             Cavity::OnVertex => Ok(false),
+            // Nothing is blocked, so the cavity cannot wrap around anything.
             Cavity::Wraps => Err(MeshError::Internal(
                 "the cavity of a vertex wraps around a constraint".into(),
             )),

@@ -38,33 +38,33 @@ impl Delaunay {
     /// Inserts a new point with perturbation (and output) index `pert`, which must exceed
     /// every index in use. Returns its vertex id, or `None` if it coincides with a vertex.
     pub fn insert_steiner(&mut self, p: Point, pert: u32) -> Result<Option<VertexId>, MeshError> {
-        self.insert_steiner_blocked(p, pert, |_, _| false)
-    }
-
-    /// [`Delaunay::insert_steiner`] with a cavity that never crosses a `blocked` face (see
-    /// [`Delaunay::insert_blocked`]).
-    pub fn insert_steiner_blocked(
-        &mut self,
-        p: Point,
-        pert: u32,
-        blocked: impl Fn([VertexId; 4], usize) -> bool,
-    ) -> Result<Option<VertexId>, MeshError> {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(MeshError::Internal(format!(
                 "Steiner point {p:?} is not finite"
             )));
         }
-        let v = self.points.len() as VertexId;
-        self.points.push(p);
-        self.orig.push(pert);
-        self.mesh.grow_vertices(self.points.len());
-        if !self.insert_blocked(v, blocked)? {
+        let v = self.push_point(p, pert);
+        if !self.insert(v)? {
             self.points.pop();
             self.orig.pop();
             return Ok(None);
         }
-        // Vertices of deleted tets all lie on the cavity boundary, so pointing every vertex
-        // of the new tets at one of them repairs the vertex-to-tet map.
+        self.point_at_created();
+        Ok(Some(v))
+    }
+
+    /// Appends point `p` with perturbation index `pert`; its vertex id.
+    fn push_point(&mut self, p: Point, pert: u32) -> VertexId {
+        let v = self.points.len() as VertexId;
+        self.points.push(p);
+        self.orig.push(pert);
+        self.mesh.grow_vertices(self.points.len());
+        v
+    }
+
+    /// Points every vertex of the last insertion's new tets at one of them. Vertices of
+    /// deleted tets all lie on the cavity boundary, so this repairs the vertex-to-tet map.
+    fn point_at_created(&mut self) {
         for i in 0..self.created.len() {
             let t = self.created[i].0;
             for &x in &self.mesh.verts(t) {
@@ -73,7 +73,6 @@ impl Delaunay {
                 }
             }
         }
-        Ok(Some(v))
     }
 
     /// Inserts a Steiner point into a constrained tetrahedralization with a cavity walled
@@ -88,10 +87,7 @@ impl Delaunay {
         if !p.iter().all(|c| c.is_finite()) {
             return Ok(Walled::Refused);
         }
-        let v = self.points.len() as VertexId;
-        self.points.push(p);
-        self.orig.push(pert);
-        self.mesh.grow_vertices(self.points.len());
+        let v = self.push_point(p, pert);
         let found = self.blocked_cavity(v, &blocked);
         if !matches!(found, Ok(super::Cavity::Ready)) {
             self.points.pop();
@@ -109,14 +105,8 @@ impl Delaunay {
             .collect();
         let last = self.last;
         self.fill_cavity()?;
+        self.point_at_created();
         let created: Vec<TetId> = self.created.iter().map(|&(t, _)| t).collect();
-        for &t in &created {
-            for &x in &self.mesh.verts(t) {
-                if x != GHOST {
-                    self.mesh.set_vertex_tet(x, t);
-                }
-            }
-        }
         Ok(Walled::Inserted {
             vertex: v,
             change: Change { old, new: created },
@@ -161,22 +151,16 @@ impl Delaunay {
         }
     }
 
-    /// The vertices on the boundary of the cavity of the last insertion: the only
-    /// vertices between which that insertion can have removed an edge.
-    pub fn last_cavity_vertices(&self, out: &mut Vec<VertexId>) {
-        self.last_cavity_vertices_unsorted(out);
-        out.sort_unstable();
-        out.dedup();
-    }
-
     /// The tets made by the last insertion, each with its face opposite the new vertex
     /// (a face of the cavity's boundary).
     pub fn last_created(&self) -> &[(TetId, usize)] {
         &self.created
     }
 
-    /// [`Delaunay::last_cavity_vertices`] in no order, with repeats.
-    pub fn last_cavity_vertices_unsorted(&self, out: &mut Vec<VertexId>) {
+    /// The vertices on the boundary of the cavity of the last insertion (the only
+    /// vertices between which that insertion can have removed an edge), in no order,
+    /// with repeats.
+    pub fn last_cavity_vertices(&self, out: &mut Vec<VertexId>) {
         out.clear();
         for &(t, _) in &self.created {
             out.extend(self.mesh.verts(t).iter().filter(|&&x| x != GHOST));
