@@ -327,8 +327,6 @@ struct Cavity {
     rim_made: bool,
     stamp: Vec<u32>,
     now: u32,
-    /// The vertices with repeats, as the mesh gives them (a buffer kept between uses).
-    spare: Vec<VertexId>,
 }
 
 impl Cavity {
@@ -342,16 +340,15 @@ impl Cavity {
         if self.stamp.len() < dt.points.len() {
             self.stamp.resize(dt.points.len(), 0);
         }
-        let mut all = std::mem::take(&mut self.spare);
-        dt.last_cavity_vertices(&mut all);
         self.verts.clear();
-        for &x in &all {
-            if self.stamp[x as usize] != self.now {
-                self.stamp[x as usize] = self.now;
-                self.verts.push(x);
+        for &(t, _) in dt.last_created() {
+            for x in dt.mesh.verts(t) {
+                if x != crate::mesh::GHOST && self.stamp[x as usize] != self.now {
+                    self.stamp[x as usize] = self.now;
+                    self.verts.push(x);
+                }
             }
         }
-        self.spare = all;
         self.rim_made = false;
     }
 

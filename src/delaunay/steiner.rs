@@ -157,16 +157,6 @@ impl Delaunay {
         &self.created
     }
 
-    /// The vertices on the boundary of the cavity of the last insertion (the only
-    /// vertices between which that insertion can have removed an edge), in no order,
-    /// with repeats.
-    pub fn last_cavity_vertices(&self, out: &mut Vec<VertexId>) {
-        out.clear();
-        for &(t, _) in &self.created {
-            out.extend(self.mesh.verts(t).iter().filter(|&&x| x != GHOST));
-        }
-    }
-
     /// The internal vertex id of each of the first `n` input indices (`u32::MAX` for
     /// points that are not vertices, such as duplicates).
     pub fn internal_ids(&self, n: usize) -> Vec<VertexId> {
