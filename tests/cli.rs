@@ -779,23 +779,26 @@ fn an_open_surface_is_refused_before_meshing_naming_its_rim() {
 }
 
 #[test]
-fn a_fin_outside_a_closed_surface_is_carved_away_with_a_warning() {
+fn a_fin_outside_a_closed_surface_is_refused_without_output() {
     let dir = tempfile::tempdir().unwrap();
     // A unit cube (triangulated) with a triangle fin on its edge 4-5, outside it.
     let off = "OFF\n9 13 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n0.5 -1 2\n\
                3 0 2 3\n3 0 3 1\n3 4 5 7\n3 4 7 6\n3 0 1 5\n3 0 5 4\n3 2 6 7\n3 2 7 3\n\
                3 0 4 6\n3 0 6 2\n3 1 3 7\n3 1 7 5\n3 4 5 8\n";
     fs::write(dir.path().join("fin.off"), off).unwrap();
-    let (code, _, err) = run_in(dir.path(), &["-peQ", "--check", "fin.off"]);
-    assert_eq!(code, 0, "{err}");
     let (code, _, err) = run_in(dir.path(), &["-pe", "fin.off"]);
-    assert_eq!(code, 0, "{err}");
+    assert_eq!(code, 3, "{err}");
     assert!(
-        err.contains("2 subsegment(s) lie outside the meshed domain"),
+        err.contains("2 polygon edge(s) lie outside the meshed domain")
+            && err.contains("5 (1, 0, 1) – 8 (0.5, -1, 2) of facet 12"),
         "{err}"
     );
+    assert_eq!(listing(dir.path()), vec!["fin.off"]);
+    // With -c the fin is inside the hull, and kept as a constraint.
+    let (code, _, err) = run_in(dir.path(), &["-pceQ", "--check", "fin.off"]);
+    assert_eq!(code, 0, "{err}");
     let edges = fs::read_to_string(dir.path().join("fin.1.edge")).unwrap();
-    assert!(!edges.lines().any(|l| {
+    assert!(edges.lines().any(|l| {
         let t: Vec<&str> = l.split_whitespace().collect();
         t.len() >= 3 && (t[1] == "8" || t[2] == "8")
     }));

@@ -317,14 +317,23 @@ fn open_facet_inside_a_closed_one_is_fine() {
 }
 
 #[test]
-fn facet_dangling_outside_is_carved_away_with_a_warning() {
-    let (code, _, stderr, _) = run("dangling_facet_outside.poly", &["-p", "--check"]);
-    assert_eq!(code, 0, "{stderr}");
-    assert!(
-        stderr.contains("2 subsegment(s) lie outside the meshed domain")
-            && stderr.contains("first (5, 9)"),
-        "{stderr}"
+fn facet_dangling_outside_is_refused_naming_its_free_edges() {
+    refused(
+        "dangling_facet_outside.poly",
+        &["-pQ"],
+        3,
+        &[
+            "dangling_facet_outside.poly: 2 polygon edge(s) lie outside the meshed domain, \
+             first (5, 9)",
+            "the surface is not closed",
+            "2 boundary edge(s)",
+            "6 (1, 0, 1) – 9 (0.5, -0.5, 1.5) of facet 7 (line",
+            "-c keeps the convex hull",
+        ],
     );
+    // With the hull kept, the fin is inside the domain and stays.
+    let (code, _, stderr, _) = run("dangling_facet_outside.poly", &["-pcQ", "--check"]);
+    assert_eq!(code, 0, "{stderr}");
 }
 
 #[test]

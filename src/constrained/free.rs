@@ -84,7 +84,12 @@ pub(super) fn insert_point(
             last,
         } => (vertex, change, last),
         Walled::OnVertex => return Ok(Inserted::OnVertex),
-        Walled::Refused => return Ok(Inserted::Refused),
+        Walled::Refused => {
+            if super::debug() {
+                eprintln!("point {w:?}: its cavity wraps around a subface");
+            }
+            return Ok(Inserted::Refused);
+        }
     };
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
@@ -94,6 +99,16 @@ pub(super) fn insert_point(
             changes,
             last,
         });
+    }
+    if super::debug() {
+        eprintln!(
+            "point {w:?}: {}",
+            if settled {
+                "a subsegment would be lost"
+            } else {
+                "the flips are stuck"
+            }
+        );
     }
     cdt.dt.undo(vertex, &changes, last);
     Ok(Inserted::Refused)

@@ -1267,9 +1267,10 @@ fn finish(
         .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
         .collect();
     subsegments.sort_unstable();
-    // A polygon dangling in the exterior (a fin on a surface) is carved away with it;
-    // its edges then bound no tet and are not subsegments of the mesh. Each vertex lists
-    // the subsegments it is the lower end of, and one pass over the tets marks those found.
+    // A polygon dangling in the exterior (a fin on a surface) would be carved away with
+    // it: its edges would bound no tet, and the mesh would silently lose a constraint.
+    // Each vertex lists the subsegments it is the lower end of, and one pass over the
+    // tets marks those found.
     let at = crate::mesh::VertexLists::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
     // `subsegments` is sorted: the lists are in its order.
     let mut found_edge = vec![false; subsegments.len()];
@@ -1281,26 +1282,17 @@ fn finish(
             }
         }
     }
-    let mut warnings = Vec::new();
-    let before = subsegments.len();
-    let mut first_lost = None;
-    let mut found_edge = found_edge.into_iter();
-    subsegments.retain(|&([a, b], _)| {
-        let kept = found_edge.next().unwrap_or(false);
-        if !kept && first_lost.is_none() {
-            first_lost = Some((a, b));
+    let lost = found_edge.iter().filter(|&&f| !f).count();
+    if let Some(k) = found_edge.iter().position(|&f| !f) {
+        let [a, b] = subsegments[k].0;
+        let name = |v: u32| v as usize + plc.first_index;
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::exterior_polygon_message(plc, lost, (name(a), name(b))),
         }
-        kept
-    });
-    if let Some((a, b)) = first_lost {
-        warnings.push(format!(
-            "{} subsegment(s) lie outside the meshed domain and were removed with the exterior, \
-             first ({}, {}): a polygon dangles outside the closed surface",
-            before - subsegments.len(),
-            a as usize + plc.first_index,
-            b as usize + plc.first_index
-        ));
+        .into());
     }
+    let warnings = Vec::new();
     stats.output_tets = tets.len();
     stats.output_subfaces = subfaces.len();
     let n_attr = plc.num_point_attrs;
@@ -1327,6 +1319,7 @@ fn finish(
         subfaces,
         subsegments,
         plc_mode: true,
+        subfaces_oriented: true,
         first_index: plc.first_index,
         convex_hull_kept: opts.keep_hull,
         ..Default::default()

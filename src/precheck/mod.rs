@@ -672,13 +672,13 @@ pub fn intersection_message(plc: &Plc, found: &[Intersection]) -> String {
     )
 }
 
-/// The error text when carving leaves nothing: the boundary edges of an open surface
-/// (edges of exactly one polygon), or why a closed one encloses nothing.
-pub fn empty_domain_message(plc: &Plc) -> String {
+/// The boundary edges of the surface (edges of exactly one polygon), in input order,
+/// with the facet of that polygon.
+fn boundary_edges(plc: &Plc) -> Vec<((u32, u32), usize)> {
     let rep = representatives(&plc.points);
-    let mut uses: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    let mut uses: FxHashMap<(u32, u32), (u32, usize)> = FxHashMap::default();
     let mut order: Vec<(u32, u32)> = Vec::new();
-    for f in &plc.facets {
+    for (fi, f) in plc.facets.iter().enumerate() {
         for poly in &f.polygons {
             if poly.iter().any(|&v| v as usize >= rep.len()) {
                 continue;
@@ -690,15 +690,41 @@ pub fn empty_domain_message(plc: &Plc) -> String {
             for k in 0..r.len() {
                 let (a, b) = (r[k], r[(k + 1) % r.len()]);
                 let e = (a.min(b), a.max(b));
-                let c = uses.entry(e).or_insert(0);
-                if *c == 0 {
+                let c = uses.entry(e).or_insert((0, fi));
+                if c.0 == 0 {
                     order.push(e);
                 }
-                *c += 1;
+                c.0 += 1;
             }
         }
     }
-    let open: Vec<(u32, u32)> = order.into_iter().filter(|e| uses[e] == 1).collect();
+    order
+        .into_iter()
+        .filter_map(|e| (uses[&e].0 == 1).then_some((e, uses[&e].1)))
+        .collect()
+}
+
+/// The list of the first boundary edges, with their coordinates.
+fn edge_list(plc: &Plc, open: &[((u32, u32), usize)], with_facet: bool) -> String {
+    let list: Vec<String> = open
+        .iter()
+        .take(SHOWN)
+        .map(|&((a, b), fi)| {
+            let e = format!("{} – {}", point_name(plc, a), point_name(plc, b));
+            if with_facet {
+                format!("{e} of {}", facet_name(plc, fi))
+            } else {
+                e
+            }
+        })
+        .collect();
+    format!("{}{}", list.join("; "), more(open.len()))
+}
+
+/// The error text when carving leaves nothing: the boundary edges of an open surface
+/// (edges of exactly one polygon), or why a closed one encloses nothing.
+pub fn empty_domain_message(plc: &Plc) -> String {
+    let open = boundary_edges(plc);
     let head =
         "the meshed domain would be empty: no tetrahedron remains after removing the exterior";
     if open.is_empty() {
@@ -707,17 +733,36 @@ pub fn empty_domain_message(plc: &Plc) -> String {
              arrangement remove everything (-c keeps the convex hull)"
         );
     }
-    let list: Vec<String> = open
-        .iter()
-        .take(SHOWN)
-        .map(|&(a, b)| format!("{} – {}", point_name(plc, a), point_name(plc, b)))
-        .collect();
     format!(
         "{head}, because the surface is not closed: {} boundary edge(s) (edges of only one \
-         polygon): {}{} (-c keeps the convex hull)",
+         polygon): {} (-c keeps the convex hull)",
         open.len(),
-        list.join("; "),
-        more(open.len())
+        edge_list(plc, &open, false)
+    )
+}
+
+/// The error text when polygon edges lie where carving removes the tets (outside the
+/// enclosed volume or in a hole), so the mesh could not contain them; `lost` counts the
+/// subsegments and names the first (output numbering).
+pub fn exterior_polygon_message(plc: &Plc, lost: usize, first: (usize, usize)) -> String {
+    let head = format!(
+        "{lost} polygon edge(s) lie outside the meshed domain, first ({}, {}), so removing \
+         the exterior would drop them and their polygons from the mesh",
+        first.0, first.1
+    );
+    let open = boundary_edges(plc);
+    if open.is_empty() {
+        return format!(
+            "{head}: the polygons with them lie in the exterior or in a hole (remove them or \
+             the hole point; -c keeps the convex hull)"
+        );
+    }
+    format!(
+        "{head}: the surface is not closed, and the polygons with its {} boundary edge(s) \
+         (edges of only one polygon) dangle outside the enclosed volume: {} (remove them; \
+         -c keeps the convex hull)",
+        open.len(),
+        edge_list(plc, &open, true)
     )
 }
 
