@@ -33,6 +33,9 @@ pub struct MeshOut {
     pub subsegments: Vec<([u32; 2], i32)>,
     /// True when the mesh came from a PLC (`-p`), which changes what `.face` and `.edge` hold.
     pub plc_mode: bool,
+    /// True when each subface is already as seen from its lower-numbered tet (as the
+    /// mesher writes them), so the `.face` writer need not find their tets again.
+    pub subfaces_oriented: bool,
     /// Number of the first node in the input (0 or 1); output follows it unless `-z`.
     pub first_index: usize,
     /// True when the exterior was kept (`-c`), so the boundary need not lie on polygons.

@@ -419,7 +419,7 @@ fn write_kind_with<'a, W: Write>(
         FileKind::Face if !w.all_faces && !mesh.plc_mode && !mesh.hull_faces.is_empty() => {
             write_hull_faces(out, mesh, w)
         }
-        FileKind::Face => write_face(out, mesh, w, d()),
+        FileKind::Face => write_face(out, mesh, w, d),
         FileKind::Edge => write_edge(out, mesh, w, d()),
         FileKind::Neigh => write_neigh(out, mesh, w, d()),
         FileKind::Vtk => super::write_extra::write_vtk(out, mesh, w),
@@ -878,11 +878,11 @@ const EDGES: [[usize; 4]; 6] = [
 ];
 
 /// Writes the `.face` file (see the module documentation for what it holds).
-pub fn write_face<W: Write>(
+pub fn write_face<'a, W: Write>(
     out: &mut W,
-    mesh: &MeshOut,
+    mesh: &'a MeshOut,
     w: &WriteOptions,
-    d: &Derived<'_>,
+    d: impl FnOnce() -> &'a Derived<'a>,
 ) -> io::Result<()> {
     let base = w.base(mesh.first_index);
     let mut b = LineBuf::new(out);
@@ -903,6 +903,7 @@ pub fn write_face<W: Write>(
         b.nl()
     };
     if w.all_faces {
+        let d = d();
         let subfaces = if mesh.plc_mode {
             Some(subface_map(mesh))
         } else {
@@ -922,9 +923,14 @@ pub fn write_face<W: Write>(
         }
     } else if mesh.plc_mode {
         // Subfaces in their list order, each oriented as seen from its lower-numbered tet.
-        let map = subface_map(mesh);
         let mut oriented: Vec<Option<[u32; 3]>> = vec![None; mesh.subfaces.len()];
+        let map = if mesh.subfaces_oriented {
+            FxHashMap::default()
+        } else {
+            subface_map(mesh)
+        };
         if !map.is_empty() {
+            let d = d();
             for (i, j) in d.owned_faces() {
                 let f = d.face_in(i, j);
                 if let Some(&k) = map.get(&sorted3(f)) {
@@ -940,6 +946,7 @@ pub fn write_face<W: Write>(
         }
     } else {
         // Hull faces, normals pointing out of the mesh.
+        let d = d();
         let count = d
             .owned_faces()
             .filter(|&(i, j)| d.neighbor(i, j).is_none())
