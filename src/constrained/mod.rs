@@ -1026,12 +1026,13 @@ fn resolve_shims(
     let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
     {
         // A shim has four vertices on one facet: facets of three vertices have none.
-        let mut count: FxHashMap<u32, u32> = FxHashMap::default();
+        let facets = cdt.subfaces.values().max().map_or(0, |&f| f as usize + 1);
+        let mut count = vec![0u32; facets];
         for &f in cdt.subfaces.values() {
-            *count.entry(f).or_default() += 1;
+            count[f as usize] += 1;
         }
         for (k, &f) in &cdt.subfaces {
-            if count[&f] > 1 {
+            if count[f as usize] > 1 {
                 facet_verts.entry(f).or_default().extend(k.iter().copied());
             }
         }

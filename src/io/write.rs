@@ -420,7 +420,7 @@ fn write_kind_with<'a, W: Write>(
             write_hull_faces(out, mesh, w)
         }
         FileKind::Face => write_face(out, mesh, w, d),
-        FileKind::Edge => write_edge(out, mesh, w, d()),
+        FileKind::Edge => write_edge(out, mesh, w, d),
         FileKind::Neigh => write_neigh(out, mesh, w, d()),
         FileKind::Vtk => super::write_extra::write_vtk(out, mesh, w),
         FileKind::Medit => super::write_extra::write_medit(out, mesh, w, d()),
@@ -966,11 +966,11 @@ pub fn write_face<'a, W: Write>(
 }
 
 /// Writes the `.edge` file (see the module documentation for what it holds).
-pub fn write_edge<W: Write>(
+pub fn write_edge<'a, W: Write>(
     out: &mut W,
-    mesh: &MeshOut,
+    mesh: &'a MeshOut,
     w: &WriteOptions,
-    d: &Derived<'_>,
+    d: impl FnOnce() -> &'a Derived<'a>,
 ) -> io::Result<()> {
     let base = w.base(mesh.first_index);
     let mut b = LineBuf::new(out);
@@ -994,6 +994,7 @@ pub fn write_edge<W: Write>(
             line(&mut b, e, m)?;
         }
     } else {
+        let d = d();
         let masks = edge_masks(d);
         let segs: FxHashMap<[u32; 2], i32> = if mesh.plc_mode {
             mesh.subsegments
