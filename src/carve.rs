@@ -95,11 +95,9 @@ fn flood(cdt: &Cdt, stack: &mut Vec<TetId>, removed: &mut [bool]) {
         }
         removed[t as usize] = true;
         for i in 0..4 {
-            if cdt.is_subface(t, i) {
-                continue;
-            }
+            // The cheap test first: most faces of a flood lead back to removed tets.
             let n = cdt.dt.mesh.adj(FaceRef::new(t, i)).tet();
-            if !removed[n as usize] {
+            if !removed[n as usize] && !cdt.is_subface(t, i) {
                 stack.push(n);
             }
         }

@@ -911,6 +911,9 @@ impl FacetContext<'_> {
     fn triangles(&self, fi: usize) -> FacetTris {
         let (plc, inv, seg_index, subsegs) = (self.plc, self.inv, self.seg_index, self.subsegs);
         let f = &self.prep.facets[fi];
+        if let Some(t) = self.unsplit_triangle(f, fi) {
+            return Ok(Some(vec![t]));
+        }
         let mut verts: Vec<VertexId> = Vec::new();
         let mut constraints: Vec<[VertexId; 2]> = Vec::new();
         let add_edge =
@@ -999,6 +1002,40 @@ impl FacetContext<'_> {
             )));
         }
         Ok(Some(tris))
+    }
+}
+
+impl FacetContext<'_> {
+    /// Most facets of surface meshes are single triangles whose edges no Steiner point
+    /// splits: their triangle, oriented as [`facet2d::single_triangle`] does, without
+    /// gathering vertices and constraints. `None` for any other facet.
+    fn unsplit_triangle(&self, f: &prepare::MergedFacet, fi: usize) -> Option<[VertexId; 3]> {
+        let ([ring], [], [], [], [_]) = (
+            &f.rings[..],
+            &f.inner_segments[..],
+            &f.isolated[..],
+            &f.holes[..],
+            &f.source_facets[..],
+        ) else {
+            return None;
+        };
+        if ring.len() != 3 || !self.extra[fi].is_empty() {
+            return None;
+        }
+        for k in 0..3 {
+            let (a, b) = (ring[k], ring[(k + 1) % 3]);
+            if let Some(&si) = self.seg_index.get(&(a.min(b), a.max(b))) {
+                if self.subsegs.chains[si].len() != 2 {
+                    return None;
+                }
+            }
+        }
+        let mut t = [0, 1, 2].map(|k| self.inv[ring[k] as usize]);
+        if t.contains(&u32::MAX) {
+            return None;
+        }
+        t.sort_unstable();
+        facet2d::single_triangle(self.points, t, f.normal)
     }
 }
 
