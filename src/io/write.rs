@@ -617,6 +617,8 @@ const O_DIRECT: Option<i32> = None;
 const DIRECT_ALIGN: usize = 4096;
 /// Bytes per direct write.
 const DIRECT_CHUNK: usize = 4 << 20;
+/// Bytes staged before a whole aligned chunk is set aside (most files are smaller).
+const DIRECT_SMALL: usize = 64 << 10;
 /// Chunks written to compare direct I/O with the page cache, half each way.
 const DIRECT_PROBES: usize = 4;
 /// How much slower than the page cache direct I/O may be on trial and still be kept:
@@ -646,8 +648,9 @@ struct DirectFile {
     probes: usize,
     /// The fastest chunk each way so far, in seconds: direct, then page cache.
     fastest: [f64; 2],
+    /// `start` bytes of padding, then the staged bytes (aligned once a whole chunk is).
     stage: Vec<u8>,
-    /// Where the aligned window starts in `stage`.
+    /// Where the window starts in `stage`.
     start: usize,
     /// Bytes staged in the window.
     len: usize,
@@ -667,23 +670,31 @@ impl DirectFile {
                 .open(path)
                 .ok()
         });
-        let (stage, start) = if direct.is_some() {
-            let stage = vec![0u8; DIRECT_CHUNK + DIRECT_ALIGN];
-            let start = stage.as_ptr().align_offset(DIRECT_ALIGN);
-            (stage, start)
-        } else {
-            (Vec::new(), 0)
-        };
         Ok(DirectFile {
             plain,
             direct,
             probes: 0,
             fastest: [f64::INFINITY; 2],
-            stage,
-            start,
+            stage: Vec::new(),
+            start: 0,
             len: 0,
             written: 0,
         })
+    }
+
+    /// Moves the staged bytes into an aligned buffer of a whole chunk, once a file turns
+    /// out to need one: most files are small, and a zeroed chunk per file cost more
+    /// than writing them (every page of it touched, with some allocators).
+    fn align_stage(&mut self) {
+        if self.stage.capacity() >= self.start + DIRECT_CHUNK {
+            return;
+        }
+        let mut aligned: Vec<u8> = Vec::with_capacity(DIRECT_CHUNK + DIRECT_ALIGN);
+        let start = aligned.as_ptr().align_offset(DIRECT_ALIGN);
+        aligned.resize(start, 0);
+        aligned.extend_from_slice(&self.stage[self.start..self.start + self.len]);
+        self.stage = aligned;
+        self.start = start;
     }
 
     /// Writes the staged whole blocks directly, keeping the rest staged.
@@ -720,6 +731,7 @@ impl DirectFile {
         let (start, len) = (self.start, self.len);
         self.stage.copy_within(start + whole..start + len, start);
         self.len -= whole;
+        self.stage.truncate(start + self.len);
         Ok(())
     }
 
@@ -750,13 +762,16 @@ impl Write for DirectFile {
                 self.plain.write_all_at(staged, self.written)?;
                 self.written += self.len as u64;
                 self.len = 0;
+                self.stage.truncate(self.start);
                 self.plain.write_all_at(buf, self.written)?;
                 self.written += buf.len() as u64;
                 return Ok(());
             }
             let n = (DIRECT_CHUNK - self.len).min(buf.len());
-            let at = self.start + self.len;
-            self.stage[at..at + n].copy_from_slice(&buf[..n]);
+            if self.len + n > DIRECT_SMALL {
+                self.align_stage();
+            }
+            self.stage.extend_from_slice(&buf[..n]);
             self.len += n;
             buf = &buf[n..];
             if self.len == DIRECT_CHUNK {
