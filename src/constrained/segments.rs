@@ -290,24 +290,26 @@ impl Recovered {
     /// Sends back to `queue` every piece that is no longer an edge (one pass over the
     /// tets).
     fn recheck_all(&mut self, dt: &Delaunay, queue: &mut Vec<Piece>) {
-        let mut missing: rustc_hash::FxHashSet<(VertexId, VertexId)> = self
-            .pieces
-            .iter()
-            .flatten()
-            .map(|pc| edge_key(pc.u, pc.v))
-            .collect();
+        // Each vertex lists the pieces it is the lower end of, as at the start: cheaper
+        // than hashing every edge of every tet.
+        let live = self.pieces.iter().flatten();
+        let other =
+            crate::mesh::VertexLists::new(dt.points.len(), live.map(|pc| edge_key(pc.u, pc.v)));
+        let mut present = vec![false; other.len()];
         for t in dt.mesh.real_tets() {
             let v = dt.mesh.verts(t);
             for (i, j) in EDGE_VERTS {
-                missing.remove(&edge_key(v[i], v[j]));
-            }
-            if missing.is_empty() {
-                return;
+                let (a, b) = edge_key(v[i], v[j]);
+                if let Some(k) = other.of(a).iter().position(|&x| x == b) {
+                    present[other.start(a) + k] = true;
+                }
             }
         }
         for slot in &mut self.pieces {
             if let Some(pc) = *slot {
-                if missing.contains(&edge_key(pc.u, pc.v)) {
+                let (a, b) = edge_key(pc.u, pc.v);
+                let k = other.of(a).iter().position(|&x| x == b);
+                if !k.is_some_and(|k| present[other.start(a) + k]) {
                     *slot = None;
                     queue.push(pc);
                 }
