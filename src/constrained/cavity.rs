@@ -541,7 +541,10 @@ fn split_sides(
 ) -> Result<Option<Sides>, MeshError> {
     let mesh = &cdt.dt.mesh;
     let mut faces: Vec<FaceRef> = Vec::new();
-    let mut index: FxHashMap<FaceRef, usize> = FxHashMap::default();
+    // Sized up front (a cavity has about two boundary faces per tet): growing maps
+    // rehash, which cost more than the lookups in small cavities.
+    let mut index: FxHashMap<FaceRef, usize> =
+        FxHashMap::with_capacity_and_hasher(2 * cavity.len(), Default::default());
     let mut cav: Vec<TetId> = cavity.to_vec();
     cav.sort_unstable();
     for &t in &cav {
@@ -802,9 +805,11 @@ impl SideDt {
     /// positive side), as mesh vertex ids: a flood fill from the faces' inner tets that
     /// never crosses them.
     fn inside(&self, faces: &[CavFace]) -> Result<Vec<[VertexId; 4]>, MeshError> {
-        let mut wall: FxHashSet<FaceRef> = FxHashSet::default();
+        let mut wall: FxHashSet<FaceRef> =
+            FxHashSet::with_capacity_and_hasher(2 * faces.len(), Default::default());
         let mut stack = Vec::new();
-        let mut inside: FxHashSet<TetId> = FxHashSet::default();
+        let mut inside: FxHashSet<TetId> =
+            FxHashSet::with_capacity_and_hasher(self.dt.mesh.num_slots(), Default::default());
         for f in faces {
             let inner = self
                 .face(f.verts)
@@ -902,7 +907,8 @@ fn graft(
     new_tets: &[[VertexId; 4]],
 ) -> Result<(), MeshError> {
     // The outside face behind each cavity face, read before the cavity is deleted.
-    let mut outside: FxHashMap<[VertexId; 3], FaceRef> = FxHashMap::default();
+    let mut outside: FxHashMap<[VertexId; 3], FaceRef> =
+        FxHashMap::with_capacity_and_hasher(top.len() + bottom.len(), Default::default());
     for f in top.iter().chain(bottom) {
         if let Some(inner) = f.inner {
             outside.insert(face_key(f.verts), cdt.dt.mesh.adj(inner));
@@ -911,7 +917,8 @@ fn graft(
     for &t in cavity {
         cdt.dt.mesh.kill_tet(t);
     }
-    let mut open: FxHashMap<[VertexId; 3], FaceRef> = FxHashMap::default();
+    let mut open: FxHashMap<[VertexId; 3], FaceRef> =
+        FxHashMap::with_capacity_and_hasher(2 * new_tets.len(), Default::default());
     let mut made = Vec::with_capacity(new_tets.len());
     for &v in new_tets {
         let t = cdt

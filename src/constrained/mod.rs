@@ -326,8 +326,7 @@ pub fn mesh_plc_with_progress(
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
                 stats.facet_steiner_points += facet_points.len() - free;
                 stats.free_steiner_points += free;
-                let (mesh, more) = finish(plc, prep, *built, opts, &mut stats, progress)?;
-                warnings.extend(more);
+                let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
                 return Ok(PlcMesh {
                     mesh,
                     stats,
@@ -906,6 +905,38 @@ impl FacetContext<'_> {
         })
     }
 
+    /// Most facets of surface meshes are single triangles whose edges no Steiner point
+    /// splits: their triangle, oriented as [`facet2d::single_triangle`] does, without
+    /// gathering vertices and constraints. `None` for any other facet.
+    fn unsplit_triangle(&self, f: &prepare::MergedFacet, fi: usize) -> Option<[VertexId; 3]> {
+        let ([ring], [], [], [], [_]) = (
+            &f.rings[..],
+            &f.inner_segments[..],
+            &f.isolated[..],
+            &f.holes[..],
+            &f.source_facets[..],
+        ) else {
+            return None;
+        };
+        if ring.len() != 3 || !self.extra[fi].is_empty() {
+            return None;
+        }
+        for k in 0..3 {
+            let (a, b) = (ring[k], ring[(k + 1) % 3]);
+            if let Some(&si) = self.seg_index.get(&(a.min(b), a.max(b))) {
+                if self.subsegs.chains[si].len() != 2 {
+                    return None;
+                }
+            }
+        }
+        let mut t = [0, 1, 2].map(|k| self.inv[ring[k] as usize]);
+        if t.contains(&u32::MAX) {
+            return None;
+        }
+        t.sort_unstable();
+        facet2d::single_triangle(self.points, t, f.normal)
+    }
+
     /// The triangles of facet `fi`: its 2D CDT with its subsegments, restricted to its
     /// polygons.
     fn triangles(&self, fi: usize) -> FacetTris {
@@ -1002,40 +1033,6 @@ impl FacetContext<'_> {
             )));
         }
         Ok(Some(tris))
-    }
-}
-
-impl FacetContext<'_> {
-    /// Most facets of surface meshes are single triangles whose edges no Steiner point
-    /// splits: their triangle, oriented as [`facet2d::single_triangle`] does, without
-    /// gathering vertices and constraints. `None` for any other facet.
-    fn unsplit_triangle(&self, f: &prepare::MergedFacet, fi: usize) -> Option<[VertexId; 3]> {
-        let ([ring], [], [], [], [_]) = (
-            &f.rings[..],
-            &f.inner_segments[..],
-            &f.isolated[..],
-            &f.holes[..],
-            &f.source_facets[..],
-        ) else {
-            return None;
-        };
-        if ring.len() != 3 || !self.extra[fi].is_empty() {
-            return None;
-        }
-        for k in 0..3 {
-            let (a, b) = (ring[k], ring[(k + 1) % 3]);
-            if let Some(&si) = self.seg_index.get(&(a.min(b), a.max(b))) {
-                if self.subsegs.chains[si].len() != 2 {
-                    return None;
-                }
-            }
-        }
-        let mut t = [0, 1, 2].map(|k| self.inv[ring[k] as usize]);
-        if t.contains(&u32::MAX) {
-            return None;
-        }
-        t.sort_unstable();
-        facet2d::single_triangle(self.points, t, f.normal)
     }
 }
 
@@ -1238,7 +1235,7 @@ fn finish(
     opts: &PlcOptions,
     stats: &mut PlcStats,
     progress: Progress<'_>,
-) -> Result<(MeshOut, Vec<String>), Error> {
+) -> Result<MeshOut, Error> {
     progress(Stage::Carve);
     let Built {
         mut cdt,
@@ -1330,7 +1327,6 @@ fn finish(
         }
         .into());
     }
-    let warnings = Vec::new();
     stats.output_tets = tets.len();
     stats.output_subfaces = subfaces.len();
     let n_attr = plc.num_point_attrs;
@@ -1362,7 +1358,7 @@ fn finish(
         convex_hull_kept: opts.keep_hull,
         ..Default::default()
     };
-    Ok((mesh, warnings))
+    Ok(mesh)
 }
 
 #[cfg(test)]

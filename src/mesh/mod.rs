@@ -327,7 +327,11 @@ impl Mesh {
     /// Every face of the real tets, keyed by its sorted vertices, with one tet side of
     /// it: constant-time face lookups for as long as the mesh does not change.
     pub fn face_index(&self) -> rustc_hash::FxHashMap<[VertexId; 3], FaceRef> {
-        let mut index = rustc_hash::FxHashMap::default();
+        // About two faces per tet: sized up front, as rehashing costs more than filling.
+        let mut index = rustc_hash::FxHashMap::with_capacity_and_hasher(
+            2 * self.num_slots() + 8,
+            Default::default(),
+        );
         for t in self.real_tets() {
             let v = self.verts(t);
             for (i, fv) in FACE_VERTS.iter().enumerate() {
