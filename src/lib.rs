@@ -55,3 +55,10 @@ pub fn tetrahedralize_with_progress(
 }
 
 mod pipeline;
+
+/// The number of cores this process may use, read once: each reading costs a dozen
+/// system calls (cgroup files), a noticeable share of a small model's run.
+pub fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}

@@ -24,7 +24,7 @@ use tetcdt::options::Options;
 
 /// The default of `--jobs`: the number of cores.
 pub fn default_jobs() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+    tetcdt::cores()
 }
 
 /// Meshes every input of `inv` (more than one); returns the exit code.

@@ -480,7 +480,7 @@ mod fast {
 
     /// The points of a large `.node` file, or `None` to leave it to the exact reader.
     pub(super) fn read(path: &Path) -> Option<Plc> {
-        let workers = std::thread::available_parallelism().map_or(1, |n| n.get().min(2));
+        let workers = crate::cores().min(2);
         let mut file = File::open(path).ok()?;
         let size = file.metadata().ok()?.len();
         if size < MIN_SIZE || workers < 2 {

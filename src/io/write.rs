@@ -1420,7 +1420,7 @@ impl<'w, W: Write> LineBuf<'w, W> {
         LineBuf {
             out,
             text: Text::new(),
-            workers: std::thread::available_parallelism().map_or(1, |n| n.get().min(2)),
+            workers: crate::cores().min(2),
         }
     }
 
