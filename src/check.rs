@@ -238,13 +238,10 @@ fn check_constraints(
                 }
                 if !joined_along(mesh, &adj, a, b) {
                     // Edges between merged coplanar polygons are not constraints: they
-                    // need no subsegments, but their facets still cover them. A polygon
-                    // dangling outside the closed surface is carved away with the
-                    // exterior (the mesher warns about it).
-                    if !edges.contains(&(a.min(b), a.max(b)))
-                        && is_segment(plc, &rep, a, b)
-                        && !outside_mesh(mesh, plc.points[a as usize], plc.points[b as usize])
-                    {
+                    // need no subsegments, but their facets still cover them. (A polygon
+                    // that carving would drop is refused by the mesher, so every
+                    // constraint edge must be here.)
+                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, &rep, a, b) {
                         pr.push(format!(
                             "facet {}: edge ({}, {}) is not covered by subsegments",
                             fi + base,
@@ -256,12 +253,6 @@ fn check_constraints(
             }
         }
     }
-}
-
-/// True if the midpoint of `a`–`b` lies in no tet (closed) of the mesh.
-fn outside_mesh(mesh: &MeshOut, a: Point, b: Point) -> bool {
-    let q: Point = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
-    !mesh.tets.iter().any(|t| in_tet(mesh, t, &q))
 }
 
 /// True if `q` lies in tet `t` (boundary included): exact orientations.
