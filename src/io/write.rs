@@ -683,8 +683,8 @@ impl DirectFile {
     }
 
     /// Moves the staged bytes into an aligned buffer of a whole chunk, once a file turns
-    /// out to need one: most files are small, and a zeroed chunk per file cost more
-    /// than writing them (every page of it touched, with some allocators).
+    /// out to need one: most files are small, and mapping and unmapping a 4 MiB chunk
+    /// for each cost more than writing them.
     fn align_stage(&mut self) {
         if self.stage.capacity() >= self.start + DIRECT_CHUNK {
             return;
