@@ -1057,37 +1057,42 @@ fn resolve_shims(
     plc: &Plc,
     opts: &PlcOptions,
 ) -> (Vec<(usize, Point)>, Option<Carved>) {
-    let mut facet_verts: FxHashMap<u32, FxHashSet<VertexId>> = FxHashMap::default();
-    {
-        // A shim has four vertices on one facet: facets of three vertices have none.
+    // A shim has four vertices on one facet, and facets of three vertices have none:
+    // each vertex lists the facets of more than one subface it is on. These short lists
+    // rule out most tets without looking up their faces. (Swaps below exchange a shim's
+    // subfaces for its other faces, on the same four vertices: the lists stay right.)
+    let on = {
         let facets = cdt.subfaces.values().max().map_or(0, |&f| f as usize + 1);
         let mut count = vec![0u32; facets];
         for &f in cdt.subfaces.values() {
             count[f as usize] += 1;
         }
-        for (k, &f) in &cdt.subfaces {
-            if count[f as usize] > 1 {
-                facet_verts.entry(f).or_default().extend(k.iter().copied());
-            }
+        let mut pairs: Vec<(VertexId, u32)> = cdt
+            .subfaces
+            .iter()
+            .filter(|(_, &f)| count[f as usize] > 1)
+            .flat_map(|(k, &f)| k.map(|v| (v, f)))
+            .collect();
+        if pairs.is_empty() {
+            return (Vec::new(), None);
         }
-    }
-    if facet_verts.is_empty() {
-        return (Vec::new(), None);
-    }
-    // A shim's vertices are all on such a facet: most tets are ruled out without
-    // looking up their faces.
-    let mut on_some = vec![false; cdt.dt.points.len()];
-    for &v in facet_verts.values().flatten() {
-        on_some[v as usize] = true;
-    }
+        pairs.sort_unstable();
+        pairs.dedup();
+        crate::mesh::VertexLists::new(cdt.dt.points.len(), pairs.into_iter())
+    };
+    let on_facet = |x: VertexId, f: u32| on.of(x).contains(&f);
+    let mut carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
     for _round in 0..64 {
-        let carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         let kept = carved.kept_mask(cdt.dt.mesh.num_slots());
-        let mut swapped = false;
+        let mut swapped: Vec<crate::mesh::TetId> = Vec::new();
         let mut needs: Vec<(usize, Point)> = Vec::new();
         for &t in &carved.tets {
             let v = cdt.dt.mesh.verts(t);
-            if !v.iter().all(|&x| on_some[x as usize]) {
+            if !on
+                .of(v[0])
+                .iter()
+                .any(|&f| (1..4).all(|i| on_facet(v[i], f)))
+            {
                 continue;
             }
             let faces: [[VertexId; 3]; 4] =
@@ -1095,10 +1100,7 @@ fn resolve_shims(
             let Some(facet) = faces.iter().find_map(|k| cdt.subfaces.get(k).copied()) else {
                 continue;
             };
-            let Some(on_facet) = facet_verts.get(&facet) else {
-                continue;
-            };
-            if !v.iter().all(|x| on_facet.contains(x)) {
+            if !v.iter().all(|&x| on_facet(x, facet)) {
                 continue;
             }
             let (sub, free): (Vec<[VertexId; 3]>, Vec<[VertexId; 3]>) =
@@ -1148,12 +1150,29 @@ fn resolve_shims(
             for k in free {
                 cdt.subfaces.insert(k, facet);
             }
-            swapped = true;
+            swapped.push(t);
         }
         // Swaps can uncover shims stacked behind others: Steiner points are only for
         // what no swap can remove.
-        if !swapped {
+        if swapped.is_empty() {
             return (needs, Some(carved));
+        }
+        if !opts.keep_hull && plc.regions.is_empty() {
+            // A swap opens the shim's faces towards removed tets and closes its others:
+            // the shim is removed, and nothing else changes, so no new flood is needed
+            // (a full one cost a tenth of a large model's time). With the hull kept,
+            // nothing floods in from outside; region floods could have passed through
+            // the shim: in those cases the carving starts afresh.
+            swapped.sort_unstable();
+            carved.tets.retain(|t| swapped.binary_search(t).is_err());
+            carved.attributes = vec![0.0; carved.tets.len()];
+            debug_assert_eq!(
+                carved.tets,
+                carve(cdt, &plc.holes, &plc.regions, opts.keep_hull).tets,
+                "a shim swap changed the carving beyond its shim"
+            );
+        } else {
+            carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         }
     }
     (Vec::new(), None)
