@@ -92,25 +92,32 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             crate::options::FacetAlgo::Flip => crate::constrained::FacetInserter::Flip,
         },
         cancel: None,
+        wake_when_prepared: None,
     };
     // The checks of single elements come first: meshing relies on them. The surface
     // checks (intersecting facets) run on a second core alongside meshing, and stop it
     // if they find the input invalid; their error then wins.
     let rep = crate::precheck::check_elements(plc)?;
     let cancel = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let popts = crate::constrained::PlcOptions {
-        cancel: Some(cancel.clone()),
-        ..popts
-    };
     let (checked, done) = std::thread::scope(|s| {
         let checker = s.spawn(|| {
+            // They start once the PLC is prepared (or meshing is over): the PLC's
+            // preparation already shares the two cores with the Delaunay stage, and a
+            // third thread there slowed that stage, the critical path, by a third.
+            std::thread::park();
             let r = crate::precheck::check_surface(plc, &rep);
             if r.is_err() {
                 cancel.store(true, std::sync::atomic::Ordering::Relaxed);
             }
             (r, start.elapsed().as_secs_f64())
         });
+        let popts = crate::constrained::PlcOptions {
+            cancel: Some(cancel.clone()),
+            wake_when_prepared: Some(checker.thread().clone()),
+            ..popts
+        };
         let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress);
+        checker.thread().unpark();
         let checked = checker
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));

@@ -50,6 +50,10 @@ pub struct PlcOptions {
     /// Set by another thread to stop the run early (the checks before meshing, run
     /// alongside, found the input invalid): the run then fails with [`CANCELLED`].
     pub cancel: Option<Arc<AtomicBool>>,
+    /// A thread to wake (`unpark`) once the PLC is prepared, the first stage that runs
+    /// beside the Delaunay tetrahedralization: work that can wait (the checks before
+    /// meshing) then takes the second core without a third thread competing for it.
+    pub wake_when_prepared: Option<std::thread::Thread>,
 }
 
 /// The failure of a run stopped through [`PlcOptions::cancel`].
@@ -108,6 +112,7 @@ impl Default for PlcOptions {
             max_steiner: 10_000_000,
             inserter: FacetInserter::Cavity,
             cancel: None,
+            wake_when_prepared: None,
         }
     }
 }
@@ -223,6 +228,9 @@ pub fn mesh_plc_with_progress(
     let (prepared, first_dt) = std::thread::scope(|s| {
         let preparing = s.spawn(|| -> Result<_, Error> {
             let base = prepare(plc, opts.merge);
+            if let Some(t) = &opts.wake_when_prepared {
+                t.unpark();
+            }
             let refused = match &base {
                 Ok(b) => !opts.keep_hull && enclosure::open_boundary(plc, b).is_some(),
                 Err(_) => true,
@@ -1392,6 +1400,7 @@ mod tests {
         let flag = Arc::new(AtomicBool::new(false));
         let opts = PlcOptions {
             cancel: Some(flag.clone()),
+            wake_when_prepared: None,
             ..Default::default()
         };
         assert!(mesh_plc(&plc, &opts).is_ok());
