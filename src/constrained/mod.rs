@@ -1168,7 +1168,7 @@ fn resolve_shims(
         if !opts.keep_hull && plc.regions.is_empty() {
             // A swap opens the shim's faces towards removed tets and closes its others:
             // the shim is removed, and nothing else changes, so no new flood is needed
-            // (a full one cost a tenth of a large model's time). With the hull kept,
+            // (a full one cost 5% of a large model's time). With the hull kept,
             // nothing floods in from outside; region floods could have passed through
             // the shim: in those cases the carving starts afresh.
             swapped.sort_unstable();
