@@ -337,6 +337,24 @@ fn facet_dangling_outside_is_refused_naming_its_free_edges() {
 }
 
 #[test]
+fn facet_in_a_hole_is_refused_naming_the_hole() {
+    refused(
+        "fin_in_hole.poly",
+        &["-pQ"],
+        3,
+        &[
+            "fin_in_hole.poly: 3 polygon edge(s) lie outside the meshed domain, first (17, 18)",
+            "dangle outside the enclosed volume or in a hole",
+            "17 (1.5, 1.5, 1.5) – 18 (2.5, 1.5, 1.5) of facet 13 (line",
+            "the hole point; -c keeps the exterior, not the holes",
+        ],
+    );
+    // -c keeps the exterior but still carves the hole.
+    let (code, _, stderr, _) = run("fin_in_hole.poly", &["-pcQ"]);
+    assert_eq!(code, 3, "{stderr}");
+}
+
+#[test]
 fn intersecting_facets_exit_3_naming_the_pairs() {
     refused(
         "crossing_facets.poly",

@@ -746,21 +746,29 @@ pub fn empty_domain_message(plc: &Plc) -> String {
 /// subsegments and names the first (output numbering).
 pub fn exterior_polygon_message(plc: &Plc, lost: usize, first: (usize, usize)) -> String {
     let head = format!(
-        "{lost} polygon edge(s) lie outside the meshed domain, first ({}, {}), so removing \
-         the exterior would drop them and their polygons from the mesh",
+        "{lost} polygon edge(s) lie outside the meshed domain, first ({}, {}), so carving \
+         would drop them and their polygons from the mesh",
         first.0, first.1
     );
+    // Holes are carved with -c too: only the exterior is kept.
+    let (place, fix) = if plc.holes.is_empty() {
+        (
+            "outside the enclosed volume",
+            "remove them; -c keeps the convex hull",
+        )
+    } else {
+        (
+            "outside the enclosed volume or in a hole",
+            "remove them, or the hole point; -c keeps the exterior, not the holes",
+        )
+    };
     let open = boundary_edges(plc);
     if open.is_empty() {
-        return format!(
-            "{head}: the polygons with them lie in the exterior or in a hole (remove them or \
-             the hole point; -c keeps the convex hull)"
-        );
+        return format!("{head}: the polygons with them lie {place} ({fix})");
     }
     format!(
         "{head}: the surface is not closed, and the polygons with its {} boundary edge(s) \
-         (edges of only one polygon) dangle outside the enclosed volume: {} (remove them; \
-         -c keeps the convex hull)",
+         (edges of only one polygon) dangle {place}: {} ({fix})",
         open.len(),
         edge_list(plc, &open, true)
     )
