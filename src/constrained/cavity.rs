@@ -437,8 +437,9 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
         .any(|&(i, j)| region.crossed_by(&cdt.dt.points, v[i], v[j]))
 }
 
-/// A set of tets as a stamp per slot, in arrays kept from one region to the next: a
-/// hash set per region cost more than the region's own cavity work.
+/// A set of tets (or of other dense ids, such as vertices) as a stamp per slot, in
+/// arrays kept from one use to the next: a hash set per region cost more than the
+/// region's own cavity work.
 pub(crate) struct SlotSet {
     stamp: Vec<u32>,
     now: u32,
@@ -452,16 +453,22 @@ thread_local! {
 impl SlotSet {
     /// An empty set for a mesh of `slots` tet slots (more may be added).
     pub(crate) fn new(slots: usize) -> Self {
-        let (mut stamp, mut now) = SLOT_SETS.with(|p| p.borrow_mut().pop()).unwrap_or_default();
-        now = now.wrapping_add(1);
-        if now == 0 {
-            stamp.iter_mut().for_each(|x| *x = 0);
-            now = 1;
+        let (stamp, now) = SLOT_SETS.with(|p| p.borrow_mut().pop()).unwrap_or_default();
+        let mut set = SlotSet { stamp, now };
+        set.clear(slots);
+        set
+    }
+
+    /// Empties the set, for `slots` slots (more may be added).
+    pub(crate) fn clear(&mut self, slots: usize) {
+        self.now = self.now.wrapping_add(1);
+        if self.now == 0 {
+            self.stamp.iter_mut().for_each(|x| *x = 0);
+            self.now = 1;
         }
-        if stamp.len() < slots {
-            stamp.resize(slots, 0);
+        if self.stamp.len() < slots {
+            self.stamp.resize(slots, 0);
         }
-        SlotSet { stamp, now }
     }
 
     /// Is tet `t` in the set?

@@ -480,16 +480,7 @@ fn attempt(
     // Each facet's triangles depend only on its vertices and subsegments, not on the
     // tets: all are computed up front, on two cores, and only they are indexed for the
     // lookups of the mesh faces.
-    let ctx = FacetContext {
-        plc,
-        prep,
-        points: &dt.points,
-        orig: &dt.orig,
-        inv: &inv,
-        seg_index: &seg_index,
-        subsegs: &subsegs,
-        extra: &extra,
-    };
+    let ctx = FacetContext::new(plc, prep, &dt, &inv, &seg_index, &subsegs, &extra);
     let mut facet_tris = ctx.triangulate_all();
     let wanted: Vec<[VertexId; 3]> = facet_tris
         .iter()
@@ -579,16 +570,9 @@ fn attempt(
                         let inserted = free::insert_point(&mut cdt, p, next_pert, at)?;
                         if let free::Inserted::Yes { vertex, .. } = inserted {
                             extra[fi].push(vertex);
-                            let ctx = FacetContext {
-                                plc,
-                                prep,
-                                points: &cdt.dt.points,
-                                orig: &cdt.dt.orig,
-                                inv: &inv,
-                                seg_index: &seg_index,
-                                subsegs: &subsegs,
-                                extra: &extra,
-                            };
+                            let ctx = FacetContext::new(
+                                plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra,
+                            );
                             let again = ctx.triangles(fi);
                             if let Ok(Some(new)) = &again {
                                 let keys: FxHashSet<[VertexId; 3]> =
@@ -880,7 +864,29 @@ struct FacetContext<'a> {
 /// A facet's triangles (`None` for a facet without rings), or why it has none.
 type FacetTris = Result<Option<Vec<[VertexId; 3]>>, Error>;
 
-impl FacetContext<'_> {
+impl<'a> FacetContext<'a> {
+    /// The context of the facets of `prep` in the tetrahedralization `dt`.
+    fn new(
+        plc: &'a Plc,
+        prep: &'a PreparedPlc,
+        dt: &'a Delaunay,
+        inv: &'a [VertexId],
+        seg_index: &'a FxHashMap<(u32, u32), usize>,
+        subsegs: &'a segments::Subsegments,
+        extra: &'a [Vec<VertexId>],
+    ) -> Self {
+        FacetContext {
+            plc,
+            prep,
+            points: &dt.points,
+            orig: &dt.orig,
+            inv,
+            seg_index,
+            subsegs,
+            extra,
+        }
+    }
+
     /// Every facet's triangles; with enough work, the facets split in two halves of about
     /// equal work, one on a second core.
     fn triangulate_all(&self) -> Vec<FacetTris> {
@@ -1331,19 +1337,12 @@ fn finish(
     subsegments.sort_unstable();
     // A polygon dangling in the exterior (a fin on a surface) would be carved away with
     // it: its edges would bound no tet, and the mesh would silently lose a constraint.
-    // Each vertex lists the subsegments it is the lower end of, and one pass over the
-    // tets marks those found.
-    let at = crate::mesh::VertexLists::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
-    // `subsegments` is sorted: the lists are in its order.
-    let mut found_edge = vec![false; subsegments.len()];
-    for t in &tets {
-        for (i, j) in crate::mesh::EDGE_VERTS {
-            let (a, b) = edge_key(t[i], t[j]);
-            if let Some(k) = at.of(a).iter().position(|&x| x == b) {
-                found_edge[at.start(a) + k] = true;
-            }
-        }
-    }
+    // One pass over the tets marks the subsegments found.
+    let mut listed =
+        crate::mesh::ListedEdges::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
+    listed.mark(tets.iter().copied());
+    // `subsegments` is sorted: the flags are in its order.
+    let found_edge = listed.flags();
     let lost = found_edge.iter().filter(|&&f| !f).count();
     if let Some(k) = found_edge.iter().position(|&f| !f) {
         let [a, b] = subsegments[k].0;

@@ -12,7 +12,7 @@ use crate::constrained::cdt::edge_key;
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
 use crate::geom::Point;
-use crate::mesh::{VertexId, EDGE_VERTS};
+use crate::mesh::VertexId;
 
 /// The recovered segments.
 #[derive(Clone, Debug, Default)]
@@ -88,27 +88,11 @@ pub fn recover_segments(
         }
     }
     // The pieces that are edges at the start, found in one pass over the tets (a walk
-    // around each would cost much more). Each vertex lists its pieces' other ends, most
-    // vertices have none or a few: cheaper than hashing every edge of every tet.
-    let other = crate::mesh::VertexLists::new(
-        dt.points.len(),
-        queue.iter().map(|pc| (pc.u.min(pc.v), pc.u.max(pc.v))),
-    );
-    let mut present = vec![false; other.len()];
-    for t in dt.mesh.real_tets() {
-        let v = dt.mesh.verts(t);
-        for (i, j) in EDGE_VERTS {
-            let (a, b) = edge_key(v[i], v[j]);
-            if let Some(k) = other.of(a).iter().position(|&x| x == b) {
-                present[other.start(a) + k] = true;
-            }
-        }
-    }
-    let was_present = |u: VertexId, v: VertexId| {
-        let (a, b) = edge_key(u, v);
-        let k = other.of(a).iter().position(|&x| x == b);
-        k.is_some_and(|k| present[other.start(a) + k])
-    };
+    // around each would cost much more).
+    let mut present =
+        crate::mesh::ListedEdges::new(dt.points.len(), queue.iter().map(|pc| edge_key(pc.u, pc.v)));
+    present.mark(dt.mesh.real_tets().map(|t| dt.mesh.verts(t)));
+    let was_present = |u: VertexId, v: VertexId| present.found(u, v);
     let mut done = Recovered::default();
     // Longest segments first (the queue is a stack): their split points are the
     // coarsest, and the shorter segments around them often need fewer points after.
@@ -123,7 +107,7 @@ pub fn recover_segments(
     // edges between vertices of its cavity, so only those pieces are checked again.
     let mut scratch = Vec::new();
     // The last insertion's cavity: its vertices, and a stamp per vertex for membership.
-    let mut cavity = Cavity::default();
+    let mut cavity = Cavity::new();
     // Vertices of some insertion's cavity: an edge between two untouched vertices that
     // was in the mesh at the start still is.
     let mut touched = vec![false; dt.points.len()];
@@ -290,26 +274,13 @@ impl Recovered {
     /// Sends back to `queue` every piece that is no longer an edge (one pass over the
     /// tets).
     fn recheck_all(&mut self, dt: &Delaunay, queue: &mut Vec<Piece>) {
-        // Each vertex lists the pieces it is the lower end of, as at the start: cheaper
-        // than hashing every edge of every tet.
         let live = self.pieces.iter().flatten();
-        let other =
-            crate::mesh::VertexLists::new(dt.points.len(), live.map(|pc| edge_key(pc.u, pc.v)));
-        let mut present = vec![false; other.len()];
-        for t in dt.mesh.real_tets() {
-            let v = dt.mesh.verts(t);
-            for (i, j) in EDGE_VERTS {
-                let (a, b) = edge_key(v[i], v[j]);
-                if let Some(k) = other.of(a).iter().position(|&x| x == b) {
-                    present[other.start(a) + k] = true;
-                }
-            }
-        }
+        let mut present =
+            crate::mesh::ListedEdges::new(dt.points.len(), live.map(|pc| edge_key(pc.u, pc.v)));
+        present.mark(dt.mesh.real_tets().map(|t| dt.mesh.verts(t)));
         for slot in &mut self.pieces {
             if let Some(pc) = *slot {
-                let (a, b) = edge_key(pc.u, pc.v);
-                let k = other.of(a).iter().position(|&x| x == b);
-                if !k.is_some_and(|k| present[other.start(a) + k]) {
+                if !present.found(pc.u, pc.v) {
                     *slot = None;
                     queue.push(pc);
                 }
@@ -318,35 +289,34 @@ impl Recovered {
     }
 }
 
-/// The vertices of the last insertion's cavity, each once, with a stamp per vertex for
+/// The vertices of the last insertion's cavity, each once, with a stamped set for
 /// membership (sorting them cost more than the insertion's other bookkeeping).
-#[derive(Default)]
 struct Cavity {
     verts: Vec<VertexId>,
+    members: super::cavity::SlotSet,
     /// The edges of the cavity's boundary faces: edges of the new tets, so still there.
     /// Made on the first question: most insertions have no recovered piece to check.
     rim: rustc_hash::FxHashSet<(VertexId, VertexId)>,
     rim_made: bool,
-    stamp: Vec<u32>,
-    now: u32,
 }
 
 impl Cavity {
+    fn new() -> Self {
+        Cavity {
+            verts: Vec::new(),
+            members: super::cavity::SlotSet::new(0),
+            rim: Default::default(),
+            rim_made: false,
+        }
+    }
+
     /// Takes the cavity of `dt`'s last insertion.
     fn of_last_insertion(&mut self, dt: &Delaunay) {
-        self.now = self.now.wrapping_add(1);
-        if self.now == 0 {
-            self.stamp.iter_mut().for_each(|x| *x = 0);
-            self.now = 1;
-        }
-        if self.stamp.len() < dt.points.len() {
-            self.stamp.resize(dt.points.len(), 0);
-        }
+        self.members.clear(dt.points.len());
         self.verts.clear();
         for &(t, _) in dt.last_created() {
             for x in dt.mesh.verts(t) {
-                if x != crate::mesh::GHOST && self.stamp[x as usize] != self.now {
-                    self.stamp[x as usize] = self.now;
+                if x != crate::mesh::GHOST && self.members.insert(x) {
                     self.verts.push(x);
                 }
             }
@@ -380,7 +350,7 @@ impl Cavity {
 
     /// Is `v` a vertex of the cavity?
     fn holds(&self, v: VertexId) -> bool {
-        self.stamp.get(v as usize) == Some(&self.now)
+        self.members.contains(&v)
     }
 }
 

@@ -129,6 +129,56 @@ impl<T: Copy + Default> VertexLists<T> {
     }
 }
 
+/// Edges, each listed under its lower vertex, with whether the tets shown to
+/// [`ListedEdges::mark`] have it: one pass over the tets and no hashing, cheaper than a
+/// set of edges when most vertices have few listed edges or none.
+pub struct ListedEdges {
+    lists: VertexLists<VertexId>,
+    found: Vec<bool>,
+}
+
+impl ListedEdges {
+    /// The edges `(lower, higher)` among vertices `0..num_vertices`, none found yet.
+    pub fn new(
+        num_vertices: usize,
+        edges: impl Iterator<Item = (VertexId, VertexId)> + Clone,
+    ) -> Self {
+        let lists = VertexLists::new(num_vertices, edges);
+        let found = vec![false; lists.len()];
+        ListedEdges { lists, found }
+    }
+
+    /// Where edge `a`–`b` (`a < b`) is in the flat order of the lists.
+    #[inline]
+    fn index(&self, a: VertexId, b: VertexId) -> Option<usize> {
+        let k = self.lists.of(a).iter().position(|&x| x == b)?;
+        Some(self.lists.start(a) + k)
+    }
+
+    /// Marks the listed edges that are edges of `tets`.
+    pub fn mark(&mut self, tets: impl IntoIterator<Item = [VertexId; 4]>) {
+        for t in tets {
+            for (i, j) in EDGE_VERTS {
+                let (a, b) = (t[i].min(t[j]), t[i].max(t[j]));
+                if let Some(k) = self.index(a, b) {
+                    self.found[k] = true;
+                }
+            }
+        }
+    }
+
+    /// Was edge `u`–`v` listed and marked?
+    pub fn found(&self, u: VertexId, v: VertexId) -> bool {
+        self.index(u.min(v), u.max(v))
+            .is_some_and(|k| self.found[k])
+    }
+
+    /// Whether each listed edge was marked, vertex by vertex in the order given.
+    pub fn flags(&self) -> &[bool] {
+        &self.found
+    }
+}
+
 /// The tet arena with a free list and a vertex-to-tet map.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
