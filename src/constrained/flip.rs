@@ -247,49 +247,47 @@ fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
     [a, b, c]
 }
 
-/// Scratch arrays indexed by vertex id, valid where their stamp is the current one:
-/// per-region hash maps cost more than the flips themselves, and clearing arrays the
-/// size of the mesh for every region would cost more still (tets: a [`SlotSet`]).
-#[derive(Default)]
+/// Per-vertex sides and heights for one region: an array indexed by vertex id, kept
+/// from one region to the next, valid where the stamped set holds the vertex.
+/// Per-region hash maps cost more than the flips themselves, and clearing arrays the
+/// size of the mesh for every region would cost more still.
 struct Marks {
-    stamp: u32,
-    vert_stamp: Vec<u32>,
+    members: SlotSet,
     vert: Vec<(i8, Approx)>,
 }
 
 thread_local! {
-    static MARKS: std::cell::RefCell<Marks> = std::cell::RefCell::new(Marks::default());
+    static MARKS: std::cell::RefCell<Vec<(i8, Approx)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl Marks {
-    /// Starts a region: a fresh stamp, arrays large enough for the mesh.
-    fn next_stamp(&mut self, verts: usize) {
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.vert_stamp.iter_mut().for_each(|x| *x = 0);
-            self.stamp = 1;
+    /// Starts a region: no vertex marked, arrays large enough for the mesh.
+    fn new(verts: usize) -> Self {
+        let mut vert = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
+        if vert.len() < verts {
+            vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
         }
-        if self.vert_stamp.len() < verts {
-            self.vert_stamp.resize(verts, 0);
-            self.vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
+        Marks {
+            members: SlotSet::new(verts),
+            vert,
         }
     }
 
     #[inline]
     fn side(&self, v: VertexId) -> Option<(i8, Approx)> {
-        (self.vert_stamp.get(v as usize) == Some(&self.stamp)).then(|| self.vert[v as usize])
+        self.members.contains(&v).then(|| self.vert[v as usize])
     }
 
     fn set_side(&mut self, v: VertexId, side: i8, h: Approx) {
-        self.vert_stamp[v as usize] = self.stamp;
+        self.members.insert(v);
         self.vert[v as usize] = (side, h);
     }
 }
 
-impl Drop for Flipper<'_> {
+impl Drop for Marks {
     fn drop(&mut self) {
-        let marks = std::mem::take(&mut self.marks);
-        MARKS.with(|m| *m.borrow_mut() = marks);
+        let vert = std::mem::take(&mut self.vert);
+        MARKS.with(|m| *m.borrow_mut() = vert);
     }
 }
 
@@ -337,8 +335,7 @@ struct Flipper<'a> {
 
 impl<'a> Flipper<'a> {
     fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
-        let mut marks = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
-        marks.next_stamp(cdt.dt.points.len());
+        let mut marks = Marks::new(cdt.dt.points.len());
         let mut in_r = SlotSet::new(cdt.dt.mesh.num_slots());
         for &t in crossing {
             in_r.insert(t);
