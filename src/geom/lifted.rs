@@ -392,7 +392,7 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
 /// The floating-point part of a flip time, compact enough to keep in a heap entry:
 /// `I` and `J` with their error bounds (NaN bounds when outside the analysed range).
 #[derive(Copy, Clone, Debug)]
-pub struct TimeKey {
+struct TimeKey {
     i: f64,
     j: f64,
     ei: f64,
@@ -401,7 +401,7 @@ pub struct TimeKey {
 
 impl FlipTime {
     /// The compact key of this flip time.
-    pub fn key(&self) -> TimeKey {
+    fn key(&self) -> TimeKey {
         TimeKey {
             i: self.i.v,
             j: self.j.v,
@@ -411,9 +411,42 @@ impl FlipTime {
     }
 }
 
+impl FlipTime {
+    /// An interval holding the flip time `τ = −I/J` (everything when `J` may not be
+    /// positive or the values leave the analysed range): most heap comparisons are
+    /// settled by two of these, with two float comparisons.
+    pub fn interval(&self) -> (f64, f64) {
+        let everything = (f64::NEG_INFINITY, f64::INFINITY);
+        let (Some(ei), Some(ej)) = (self.i.err(), self.j.err()) else {
+            return everything;
+        };
+        let (dlo, dhi) = (self.j.v - ej, self.j.v + ej);
+        // Also false for NaN.
+        if dlo.partial_cmp(&0.0) != Some(Ordering::Greater) {
+            return everything;
+        }
+        let (nlo, nhi) = (-self.i.v - ei, -self.i.v + ei);
+        let lo = nlo / if nlo >= 0.0 { dhi } else { dlo };
+        let hi = nhi / if nhi >= 0.0 { dlo } else { dhi };
+        // Each bound went through three roundings (of the numerator, the denominator
+        // and the quotient), each relative to its result; the absolute term covers
+        // subnormal results.
+        let w = 8.0 * f64::EPSILON;
+        let (lo, hi) = (
+            lo - lo.abs() * w - f64::MIN_POSITIVE,
+            hi + hi.abs() * w + f64::MIN_POSITIVE,
+        );
+        if lo.is_nan() || hi.is_nan() {
+            everything
+        } else {
+            (lo, hi)
+        }
+    }
+}
+
 /// The sign of `I_b·J_a − I_a·J_b` from two keys, if the error bounds settle it.
 #[inline]
-pub fn key_cross(a: &TimeKey, b: &TimeKey) -> Option<i32> {
+fn key_cross(a: &TimeKey, b: &TimeKey) -> Option<i32> {
     let (eia, eja, eib, ejb) = (a.ei, a.ej, b.ei, b.ej);
     let (x, y) = (b.i * a.j, a.i * b.j);
     let s = x - y;
@@ -609,6 +642,7 @@ mod tests {
         for (a, ia, ja) in &certs {
             for (b, ib, jb) in &certs {
                 let want = (ib * ja - ia * jb).signum() as i32;
+                assert_interval_agrees(a, b, want);
                 let got = cross_sign(a, b, &lift, &mut counts);
                 let back = cross_sign(b, a, &lift, &mut counts);
                 assert_eq!(got, -back);
@@ -647,6 +681,7 @@ mod tests {
                 cert(&lift, p, [0, 1, 2, 3, 4]),
                 cert(&lift, q, [0, 1, 2, 3, 5]),
             );
+            assert_interval_agrees(&a, &b, want);
             let got = cross_sign(&a, &b, &lift, &mut counts);
             if want != 0 {
                 assert_eq!(got, want);
@@ -654,5 +689,29 @@ mod tests {
                 assert_eq!(got, -cross_sign(&b, &a, &lift, &mut counts));
             }
         }
+        assert!(decided_by_intervals() > 1000);
+    }
+
+    thread_local! {
+        static DECIDED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    fn decided_by_intervals() -> usize {
+        DECIDED.with(|d| d.get())
+    }
+
+    /// Where the intervals of two flip times are disjoint, they order them as the exact
+    /// sign `want` of `I_b·J_a − I_a·J_b` does (negative: `a` first).
+    fn assert_interval_agrees(a: &FlipTime, b: &FlipTime, want: i32) {
+        let ((alo, ahi), (blo, bhi)) = (a.interval(), b.interval());
+        assert!(alo <= ahi && blo <= bhi);
+        if ahi < blo {
+            assert_eq!(want, -1, "{:?} before {:?}", (alo, ahi), (blo, bhi));
+        } else if bhi < alo {
+            assert_eq!(want, 1, "{:?} after {:?}", (alo, ahi), (blo, bhi));
+        } else {
+            return;
+        }
+        DECIDED.with(|d| d.set(d.get() + 1));
     }
 }
