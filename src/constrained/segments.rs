@@ -214,7 +214,19 @@ pub fn recover_segments(
 #[derive(Default)]
 struct Recovered {
     pieces: Vec<Option<Piece>>,
-    at: Option<rustc_hash::FxHashMap<VertexId, Vec<usize>>>,
+    /// Indexed by vertex: every cavity vertex is looked up after every insertion, and
+    /// a hash map's lookups cost more than the rest of the check.
+    at: Option<Vec<Vec<usize>>>,
+}
+
+/// Notes piece `i` at its two ends.
+fn note_at(at: &mut Vec<Vec<usize>>, pc: &Piece, i: usize) {
+    let top = pc.u.max(pc.v) as usize;
+    if at.len() <= top {
+        at.resize_with(top + 1, Vec::new);
+    }
+    at[pc.u as usize].push(i);
+    at[pc.v as usize].push(i);
 }
 
 impl Recovered {
@@ -222,8 +234,7 @@ impl Recovered {
         let i = self.pieces.len();
         self.pieces.push(Some(pc));
         if let Some(at) = &mut self.at {
-            at.entry(pc.u).or_default().push(i);
-            at.entry(pc.v).or_default().push(i);
+            note_at(at, &pc, i);
         }
     }
 
@@ -238,11 +249,11 @@ impl Recovered {
         scratch: &mut Vec<crate::mesh::TetId>,
     ) {
         let at = self.at.get_or_insert_with(|| {
-            let mut at: rustc_hash::FxHashMap<VertexId, Vec<usize>> = Default::default();
+            let mut at: Vec<Vec<usize>> = Vec::new();
+            at.resize_with(dt.points.len(), Vec::new);
             for (i, pc) in self.pieces.iter().enumerate() {
                 if let Some(pc) = pc {
-                    at.entry(pc.u).or_default().push(i);
-                    at.entry(pc.v).or_default().push(i);
+                    note_at(&mut at, pc, i);
                 }
             }
             at
@@ -252,7 +263,7 @@ impl Recovered {
             if x == new {
                 continue;
             }
-            let Some(list) = at.get_mut(&x) else {
+            let Some(list) = at.get_mut(x as usize).filter(|l| !l.is_empty()) else {
                 continue;
             };
             list.retain(|&i| self.pieces[i].is_some());

@@ -158,16 +158,14 @@ pub(crate) fn free_points(
     };
     let mut slab_cache: Vec<Option<Option<Slab>>> = Vec::new();
     slab_cache.resize_with(prep.facets.len(), || None);
-    let mut slab_at = |fi: u32| -> Option<Slab> {
-        slab_cache[fi as usize]
-            .get_or_insert_with(|| slab_of(fi as usize))
-            .clone()
-    };
     let mut on = |orig: u32, p: &Point, f: u32| -> bool {
         if (orig as usize) < n_input {
             facets_of(orig).contains(&f)
         } else {
-            slab_at(f).is_some_and(|s| s.holds(p))
+            slab_cache[f as usize]
+                .get_or_insert_with(|| slab_of(f as usize))
+                .as_ref()
+                .is_some_and(|s| s.holds(p))
         }
     };
     let mut flat: Vec<(crate::mesh::TetId, u32)> = Vec::new();
@@ -175,30 +173,48 @@ pub(crate) fn free_points(
         let v = cdt.dt.mesh.verts(t);
         let p = v.map(|x| cdt.dt.points[x as usize]);
         let o = v.map(|x| cdt.dt.orig[x as usize]);
+        // With an input vertex, the facets the tet can lie on are among that vertex's
+        // (the shortest such list is tried, in increasing order: the first facet found
+        // is the lowest of all candidates, as below). Most flat tets go this way.
+        if let Some(x) = (0..4)
+            .filter(|&i| (o[i] as usize) < n_input)
+            .min_by_key(|&i| facets_of(o[i]).len())
+        {
+            if let Some(&f) = facets_of(o[x])
+                .iter()
+                .find(|&&f| (0..4).all(|i| on(o[i], &p[i], f)))
+            {
+                flat.push((t, f));
+            }
+            continue;
+        }
         // A tet of Steiner points on segments (between nearly parallel segments) has no
-        // input vertex to name its facet: the segments' ends do.
-        let mut candidates: Vec<u32> = Vec::new();
-        for i in 0..4 {
-            if (o[i] as usize) < n_input {
-                candidates.extend_from_slice(facets_of(o[i]));
-            } else if let Some(ends) = seg_ends.get(&v[i]) {
-                candidates.extend(ends.iter().flat_map(|&x| facets_of(x).iter().copied()));
+        // input vertex to name its facet: the segments' ends do. The lowest facet of
+        // theirs that holds all four is taken (each list is increasing).
+        let mut best: Option<u32> = None;
+        for x in v.iter().filter_map(|x| seg_ends.get(x)).flatten() {
+            for &f in facets_of(*x) {
+                if best.is_some_and(|b| b <= f) {
+                    break;
+                }
+                if (0..4).all(|i| on(o[i], &p[i], f)) {
+                    best = Some(f);
+                }
             }
         }
-        candidates.sort_unstable();
-        candidates.dedup();
-        for f in candidates {
-            if (0..4).all(|i| on(o[i], &p[i], f)) {
-                flat.push((t, f));
-                break;
-            }
+        if let Some(f) = best {
+            flat.push((t, f));
         }
     }
     if flat.is_empty() {
         return FlatTets::default();
     }
     // A free point must leave every facet's slab: all are needed from here on.
-    let slabs: Vec<Option<Slab>> = (0..prep.facets.len() as u32).map(&mut slab_at).collect();
+    let slabs: Vec<Option<Slab>> = slab_cache
+        .into_iter()
+        .enumerate()
+        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(fi)))
+        .collect();
     let mut out = FlatTets::default();
     for (t, f) in flat {
         let Some(slab) = slabs[f as usize].as_ref() else {
