@@ -383,6 +383,26 @@ fn intersecting_facets_exit_3_naming_the_pairs() {
     );
 }
 
+/// Facets that cross only because two vertices differ by a rounding error (as in
+/// gmsh's `object.stl`): the message names the two vertices.
+#[test]
+fn crossing_at_nearly_coincident_vertices_names_them() {
+    refused(
+        "near_coincident.off",
+        &["-pQ"],
+        3,
+        &[
+            "6 pair(s) of facets intersect",
+            "they meet at nearly coincident vertices",
+            "vertices 0 (0, 0, 0) and 4 (",
+            "are only 1.73e-17 apart",
+        ],
+    );
+    // Crossings with no such vertices say nothing of them.
+    let (_, _, stderr, _) = run("crossing_facets.poly", &["-pQ"]);
+    assert!(!stderr.contains("nearly coincident"), "{stderr}");
+}
+
 #[test]
 fn segment_through_a_facet_exits_3() {
     refused(

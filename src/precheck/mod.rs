@@ -657,19 +657,72 @@ pub fn intersection_line(plc: &Plc, x: &Intersection) -> String {
     )
 }
 
-/// The error text for intersecting facets: the count and the first pairs.
+/// The error text for intersecting facets: the count and the first pairs, and the
+/// nearly coincident vertices that make them cross, if any.
 pub fn intersection_message(plc: &Plc, found: &[Intersection]) -> String {
     let list: Vec<String> = found
         .iter()
         .take(SHOWN)
         .map(|x| intersection_line(plc, x))
         .collect();
+    let near = near_coincident(plc, found);
+    let cause = if near.is_empty() {
+        String::new()
+    } else {
+        let pairs: Vec<String> = near
+            .iter()
+            .take(SHOWN)
+            .map(|&(d, a, b)| {
+                format!(
+                    "vertices {} and {} are only {d:.2e} apart",
+                    point_name(plc, a),
+                    point_name(plc, b)
+                )
+            })
+            .collect();
+        format!(
+            "\n  they meet at nearly coincident vertices, which are distinct points (only \
+             exactly equal ones are merged): merging them in the model removes these \
+             crossings\n  {}{}",
+            pairs.join("\n  "),
+            more(near.len())
+        )
+    };
     format!(
-        "{} pair(s) of facets intersect (-d lists them all and writes their triangles):\n  {}{}",
+        "{} pair(s) of facets intersect (-d lists them all and writes their triangles):\n  {}{}{cause}",
         found.len(),
         list.join("\n  "),
         more(found.len())
     )
+}
+
+/// Distinct vertices of intersecting triangles, one from each, closer than a rounding
+/// error of the model's size: (distance, lower id, higher id), closest first.
+fn near_coincident(plc: &Plc, found: &[Intersection]) -> Vec<(f64, u32, u32)> {
+    let size = plc
+        .points
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    let tol = 1e-12 * size;
+    let mut near: Vec<(f64, u32, u32)> = Vec::new();
+    for x in found {
+        for &a in &x.tris[0] {
+            for &b in &x.tris[1] {
+                if a == b {
+                    continue;
+                }
+                let (pa, pb) = (plc.points[a as usize], plc.points[b as usize]);
+                let d = (0..3).map(|k| (pa[k] - pb[k]).powi(2)).sum::<f64>().sqrt();
+                if d <= tol {
+                    near.push((d, a.min(b), a.max(b)));
+                }
+            }
+        }
+    }
+    near.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    near.dedup_by(|x, y| (x.1, x.2) == (y.1, y.2));
+    near
 }
 
 /// The boundary edges of the surface (edges of exactly one polygon), in input order,
