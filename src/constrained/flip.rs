@@ -93,48 +93,36 @@ enum Refusal {
     NotFlippable,
 }
 
-/// A certified face: its flip time, and the face as seen from its first tet.
-struct Event {
-    time: FlipTime,
-    face: FaceRef,
-}
-
-/// What an event needs to stay valid: its two tets, still in R, with the generations
-/// they had when it was certified.
+/// A certified face, in 36 bytes: the face as seen from its first tet, the tet on its
+/// other side, the generations both tets had when it was certified (it stays valid
+/// while they are unchanged and in R), and the certificate's five vertices (the face's
+/// three and the two apices). The flip time itself is only in the heap entry, as an
+/// interval; where that does not settle an order, which is rare, it is computed again
+/// from the five vertices, which never move. Events are written at random slots, so
+/// their size is cache misses.
 #[derive(Clone, Copy)]
-struct EventCheck {
-    t1: TetId,
+struct Event {
+    face: FaceRef,
     t2: TetId,
     g1: u32,
     g2: u32,
+    verts: [VertexId; 5],
 }
 
-/// The five points of a flip certificate, sorted, with which are left vertices: two
-/// certificates with the same five are the same event (one lifted hyperplane).
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct Five {
-    ids: [u32; 5],
-    left: u8,
-}
-
-impl Five {
-    fn of(time: &FlipTime) -> Self {
-        let mut k: [usize; 5] = std::array::from_fn(|i| i);
-        k.sort_unstable_by_key(|&i| time.ids[i]);
-        Five {
-            ids: k.map(|i| time.ids[i]),
-            left: k
-                .iter()
-                .enumerate()
-                .fold(0, |m, (j, &i)| m | (u8::from(time.left[i]) << j)),
-        }
+impl Event {
+    /// The five vertices, sorted: two certificates with the same five are the same
+    /// event (one lifted hyperplane).
+    fn five(&self) -> [VertexId; 5] {
+        let mut v = self.verts;
+        v.sort_unstable();
+        v
     }
 }
 
 /// A queued event: an interval `[lo, hi]` holding its flip time, and its index with a
-/// flag. Most comparisons are settled from the entries alone, without touching the
-/// events, which are large; and entries are kept small, since the heap, stale entries
-/// included, should stay in cache (40-byte entries made the flips 15% slower).
+/// flag. Nearly all comparisons are settled from the entries alone, without touching
+/// the events; and entries are kept small, since the heap, stale entries included,
+/// should stay in cache (40-byte entries made the flips 15% slower).
 #[derive(Clone, Copy)]
 struct Entry {
     lo: f64,
@@ -430,10 +418,6 @@ struct Flipper<'a> {
     r_list: Vec<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
     events: Vec<Event>,
-    /// For each event, what keeps it valid.
-    checks: Vec<EventCheck>,
-    /// For each event, its five points (for ties, without touching the events).
-    fives: Vec<Five>,
     /// Tet generations, for [`Flipper::valid`].
     gens: Gens,
     /// Event slots free for reuse.
@@ -481,8 +465,6 @@ impl<'a> Flipper<'a> {
             r_list: crossing.to_vec(),
             region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
             events: Vec::new(),
-            checks: Vec::new(),
-            fives: Vec::new(),
             gens: Gens::new(cdt_slots),
             free_events: Vec::new(),
             heap: Vec::new(),
@@ -634,8 +616,8 @@ impl<'a> Flipper<'a> {
                     continue;
                 }
                 let time = self.flip_time(f);
-                let now = &self.events[cur as usize].time;
-                if cross_sign(now, &time, &self.lift, &mut self.cmp) > 0 {
+                let now = self.time_of(cur);
+                if cross_sign(&now, &time, &self.lift, &mut self.cmp) > 0 {
                     self.counts.not_regular += 1;
                     self.push_event(f, time, true);
                 }
@@ -680,17 +662,33 @@ impl<'a> Flipper<'a> {
     /// tet last): the five points, their perturbation indices, which are left, and their
     /// heights.
     fn certificate(&self, f: FaceRef) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
+        self.certificate_of(self.certificate_verts(f))
+    }
+
+    /// The certificate's five vertices: face `f` seen from its tet, then the apices of
+    /// its tet and of the other.
+    fn certificate_verts(&self, f: FaceRef) -> [VertexId; 5] {
         let mesh = &self.cdt.dt.mesh;
         let g = mesh.adj(f);
         let s = mesh.face_verts(f.tet(), f.face());
         let v = mesh.verts(f.tet())[f.face()];
         let w = mesh.verts(g.tet())[g.face()];
-        let ids = [s[0], s[1], s[2], v, w];
+        [s[0], s[1], s[2], v, w]
+    }
+
+    /// [`Flipper::certificate`] of five vertices in certificate order.
+    fn certificate_of(&self, ids: [VertexId; 5]) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
         let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
         let zero = Approx { v: 0.0, p: 0.0 };
         let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
         (pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+    }
+
+    /// The flip time of event `e`, computed again from its five vertices.
+    fn time_of(&self, e: u32) -> FlipTime {
+        let (pts, orig, left, heights) = self.certificate_of(self.events[e as usize].verts);
+        FlipTime::new(pts, orig, left, heights)
     }
 
     /// The flip certificate of face `f`, if it ever flips.
@@ -713,27 +711,22 @@ impl<'a> Flipper<'a> {
     }
 
     fn push_event(&mut self, f: FaceRef, time: FlipTime, forced: bool) {
-        let (t1, t2) = (f.tet(), self.cdt.dt.mesh.adj(f).tet());
-        let check = EventCheck {
-            t1,
+        let t2 = self.cdt.dt.mesh.adj(f).tet();
+        let e = Event {
+            face: f,
             t2,
-            g1: self.gens.of(t1),
+            g1: self.gens.of(f.tet()),
             g2: self.gens.of(t2),
+            verts: self.certificate_verts(f),
         };
         let (lo, hi) = time.interval();
-        let five = Five::of(&time);
-        let e = Event { time, face: f };
         let idx = match self.free_events.pop() {
             Some(i) => {
                 self.events[i as usize] = e;
-                self.checks[i as usize] = check;
-                self.fives[i as usize] = five;
                 i
             }
             None => {
                 self.events.push(e);
-                self.checks.push(check);
-                self.fives.push(five);
                 (self.events.len() - 1) as u32
             }
         };
@@ -810,12 +803,12 @@ impl<'a> Flipper<'a> {
     fn earlier_close(&mut self, a: u32, b: u32) -> bool {
         // Nearly all are faces of one coming flip (the three around an edge of a 3-2
         // flip): the same five points, the same event.
-        if self.fives[a as usize] == self.fives[b as usize] {
+        if self.events[a as usize].five() == self.events[b as usize].five() {
             self.cmp.filtered += 1;
             return a < b;
         }
-        let (ea, eb) = (&self.events[a as usize], &self.events[b as usize]);
-        match cross_sign(&ea.time, &eb.time, &self.lift, &mut self.cmp) {
+        let (ta, tb) = (self.time_of(a), self.time_of(b));
+        match cross_sign(&ta, &tb, &self.lift, &mut self.cmp) {
             0 => a < b,
             s => s < 0,
         }
@@ -825,11 +818,9 @@ impl<'a> Flipper<'a> {
     /// (Then they are still glued at its face.)
     #[inline]
     fn valid(&self, e: u32) -> bool {
-        let c = self.checks[e as usize];
-        self.in_r(c.t1)
-            && self.in_r(c.t2)
-            && self.gens.of(c.t1) == c.g1
-            && self.gens.of(c.t2) == c.g2
+        let c = &self.events[e as usize];
+        let t1 = c.face.tet();
+        self.in_r(t1) && self.in_r(c.t2) && self.gens.of(t1) == c.g1 && self.gens.of(c.t2) == c.g2
     }
 
     /// Removes face `f` by a 2-3, 3-2 or 4-4 flip, if the tets around it allow one and
