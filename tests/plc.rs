@@ -648,3 +648,41 @@ fn a_steiner_point_on_a_polygon_goes_into_the_cdt_without_a_restart() {
         }
     }
 }
+
+/// STL models on which our CDT and TetGen's differ only by the numbering of the welded
+/// points (`data/stl_numbering/README.md`): numbered as TetGen numbers them, our tets are
+/// TetGen's; numbered by first appearance, as we read STL, the mesh is valid and has the
+/// same points.
+#[test]
+fn stl_cdt_is_tetgens_with_tetgens_numbering() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join("stl_numbering");
+    let out = tempfile::tempdir().unwrap();
+    for name in ["cube", "bar"] {
+        let theirs = read_mesh(&dir.join(format!("{name}.1")));
+        let renumbered = dir.join(format!("{name}.tetgen_numbering.smesh"));
+        let prefix = out.path().join(format!("{name}_tg"));
+        let (code, err) = run(&renumbered, &prefix, &["-pQ"]);
+        assert_eq!(code, 0, "{name}: {err}");
+        let ours = read_mesh(&prefix);
+        assert!(
+            tet_keys(&ours) == tet_keys(&theirs),
+            "{name}: with TetGen's numbering our tets differ from TetGen's"
+        );
+        let prefix = out.path().join(format!("{name}_stl"));
+        let (code, err) = run(
+            &dir.join(format!("{name}.stl")),
+            &prefix,
+            &["-pQ", "--check"],
+        );
+        assert_eq!(code, 0, "{name}.stl: {err}");
+        let from_stl = read_mesh(&prefix);
+        let points = |m: &Mesh| m.points.iter().map(|&p| key(p)).collect::<BTreeSet<_>>();
+        assert_eq!(
+            points(&from_stl),
+            points(&theirs),
+            "{name}.stl: other points"
+        );
+    }
+}
