@@ -202,31 +202,7 @@ def read_mesh(prefix):
     tets = [tuple(int(v) - base for v in r[1:5]) for r in ele_rows[1:1 + m]]
     return pts, tets
 
-def renumber(inp, tg, out):
-    """Writes the STL `inp` as a .smesh whose points are numbered as in TetGen's output
-    TG.node (STL repeats every corner, and which copy of a point TetGen keeps, hence its
-    number, follows TetGen's insertion order), so that the symbolic perturbation breaks
-    ties in the same order as TetGen's. Exit 1 if TetGen's points are not the STL's."""
-    corners = input_vertices(inp)
-    pts, _ = read_mesh(tg)
-    index = {p: i for i, p in enumerate(pts)}
-    if any(c not in index for c in corners) or len(index) != len(set(corners)):
-        sys.exit(1)
-    tris = [[index[c] for c in corners[k:k + 3]] for k in range(0, len(corners) - 2, 3)]
-    tris = [t for t in tris if len(set(t)) == 3]
-    with open(out, "w") as f:
-        f.write(f"{len(pts)} 3 0 0\n")
-        for i, p in enumerate(pts):
-            f.write(f"{i + 1} {p[0]!r} {p[1]!r} {p[2]!r}\n")
-        f.write(f"{len(tris)} 0\n")
-        for t in tris:
-            f.write(f"3 {t[0] + 1} {t[1] + 1} {t[2] + 1}\n")
-        f.write("0\n0\n")
-
 def main():
-    if sys.argv[1] == "--renumber":
-        renumber(*sys.argv[2:5])
-        return
     inp, ours, tg = sys.argv[1:4]
     verts = input_vertices(inp)
     distinct = set(verts) if verts is not None else None
@@ -516,7 +492,8 @@ for rel in "${MODELS[@]}"; do
         n_ident_cases=$((n_ident_cases + 1))
         renumbered=0
         if [[ "$ident" == no && "$ext" == stl ]] &&
-            python3 "$HELPER" --renumber "$input" "$tg_prefix" "$dir/tg_numbering.smesh" 2>/dev/null &&
+            python3 "$ROOT/scripts/stl-tetgen-numbering.py" "$input" "$tg_prefix.node" \
+                "$dir/tg_numbering.smesh" 2>/dev/null &&
             "$TETCDT" -pQ -o "$dir/renumbered" "$dir/tg_numbering.smesh" >/dev/null 2>&1; then
             # The same PLC with TetGen's numbering of the welded points: the same tets?
             rstats="$(python3 "$HELPER" "$dir/tg_numbering.smesh" "$dir/renumbered" "$tg_prefix" 2>/dev/null)"
