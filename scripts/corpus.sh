@@ -119,8 +119,11 @@ fi
 # ---------------------------------------------------------------------------------------
 # The helper: input vertices, Steiner counts, tet-set comparison by coordinates.
 HELPER="$WORK/helper.py"
-cat >"$HELPER" <<'EOF'
+echo "SCRIPTS = '$ROOT/scripts'" >"$HELPER"
+cat >>"$HELPER" <<'EOF'
 import sys
+sys.path.insert(0, SCRIPTS)
+from stl_tetgen_numbering import corners as stl_corners
 
 def lines_of(path):
     out = []
@@ -161,17 +164,7 @@ def input_vertices(path):
                 return [tuple(float(c) for c in words[i + 2 + 4 * j: i + 5 + 4 * j]) for j in range(n)]
         return []
     if ext == "stl":
-        with open(path, "rb") as f:
-            data = f.read()
-        if data[:5].lower() == b"solid" and b"facet" in data[:1000]:
-            return [tuple(float(c) for c in r[1:4]) for r in lines_of(path) if r[0].lower() == "vertex"]
-        import struct
-        n = struct.unpack("<I", data[80:84])[0]
-        pts = []
-        for k in range(n):
-            vals = struct.unpack("<12f", data[84 + 50 * k: 84 + 50 * k + 48])
-            pts += [tuple(float(v) for v in vals[3 + 3 * j: 6 + 3 * j]) for j in range(3)]
-        return pts
+        return stl_corners(path)
     if ext == "ply":
         with open(path, "rb") as f:
             data = f.read()
@@ -492,7 +485,7 @@ for rel in "${MODELS[@]}"; do
         n_ident_cases=$((n_ident_cases + 1))
         renumbered=0
         if [[ "$ident" == no && "$ext" == stl ]] &&
-            python3 "$ROOT/scripts/stl-tetgen-numbering.py" "$input" "$tg_prefix.node" \
+            python3 "$ROOT/scripts/stl_tetgen_numbering.py" "$input" "$tg_prefix.node" \
                 "$dir/tg_numbering.smesh" 2>/dev/null &&
             "$TETCDT" -pQ -o "$dir/renumbered" "$dir/tg_numbering.smesh" >/dev/null 2>&1; then
             # The same PLC with TetGen's numbering of the welded points: the same tets?

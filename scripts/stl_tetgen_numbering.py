@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Writes an STL file as a .smesh whose points are numbered as in TetGen's output .node.
 
-usage: stl-tetgen-numbering.py INPUT.stl TETGEN.node OUTPUT.smesh
+usage: stl_tetgen_numbering.py INPUT.stl TETGEN.node OUTPUT.smesh
 
 An STL file repeats every triangle corner. TetGen numbers each welded point by the copy
 its (randomized Hilbert) insertion order reaches first; tetcdt by its first appearance.
 The symbolic perturbation breaks ties among cospherical points by these numbers, so the
 two CDTs of a cospherical STL model differ. Meshed from this .smesh, the same PLC with
 TetGen's numbering, ours must be TetGen's, tet for tet. Used by scripts/corpus.sh and
-scripts/gen-stl-numbering.sh. Exits 1 if TetGen's points are not the STL's corners.
+scripts/gen-stl-numbering.sh (corpus.sh's helper also reads STL with `corners`). Exits 1 if TetGen's points are not the STL's corners.
 """
 import struct
 import sys
@@ -52,4 +52,5 @@ def main():
         f.write("0\n0\n")
 
 
-main()
+if __name__ == "__main__":
+    main()
