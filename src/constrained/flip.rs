@@ -586,15 +586,25 @@ impl<'a> Flipper<'a> {
     fn after_flip(&mut self, new: &[TetId], due: bool) {
         let skip_inner = due && new.len() <= 3;
         for &t in new {
-            let crossing_tet = self.is_crossing(&self.cdt.dt.mesh.verts(t));
+            // Which of the tet's vertices are left and right, as bit masks: a face (all
+            // vertices but one) crosses if both masks keep a bit without that vertex.
+            let (mut left, mut right) = (0u8, 0u8);
+            for (k, v) in self.cdt.dt.mesh.verts(t).into_iter().enumerate() {
+                match self.marks.side(v) {
+                    Some((1, _)) => left |= 1 << k,
+                    Some((-1, _)) => right |= 1 << k,
+                    _ => {}
+                }
+            }
+            let crossing_tet = left != 0 && right != 0;
             for i in 0..4 {
                 let f = FaceRef::new(t, i);
                 let g = self.cdt.dt.mesh.adj(f);
                 if !self.in_r(g.tet()) {
                     continue;
                 }
-                let fv = self.cdt.dt.mesh.face_verts(t, i);
-                if self.is_crossing(&fv) {
+                let others = !(1u8 << i);
+                if left & others != 0 && right & others != 0 {
                     // A face between two new tets: certified once, from the lower id.
                     let inner = new.contains(&g.tet());
                     if !inner || (g.tet() > t && !skip_inner) {
@@ -605,6 +615,7 @@ impl<'a> Flipper<'a> {
                 if crossing_tet || self.is_crossing(&self.cdt.dt.mesh.verts(g.tet())) {
                     continue;
                 }
+                let fv = self.cdt.dt.mesh.face_verts(t, i);
                 if self.region_faces.contains(&face_key(fv)) || self.cdt.is_subface(t, i) {
                     continue;
                 }
