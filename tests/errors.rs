@@ -610,3 +610,21 @@ fn failed_run_keeps_earlier_outputs() {
     }
     assert_eq!(listing(d).len(), 6, "{:?}", listing(d));
 }
+
+/// Found by `tests/fuzz.rs`: a vertex of `prism_n40_d1e-5_s1.poly` moved 4.3e9 units out
+/// makes two side quads into needles billions of times longer than wide, whose sides
+/// rounding confuses: a cavity grew around its polygon, an internal error. Such a
+/// region now asks for a Steiner point on the polygon, and the restarts' bound ends it
+/// with a reason (TetGen aborts on it too).
+#[test]
+fn fuzz_regression_cavity_around_a_needle_polygon() {
+    let (code, stderr) = mutated(
+        "plc/prism_n40_d1e-5_s1.poly",
+        "\n11 -0.0782172325201153 0.4938441702975689 ",
+        "\n11 -0.0782172325201153 4294967295 ",
+        &["-pQ"],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("still conflict"), "{stderr}");
+    assert!(!stderr.contains("internal error"), "{stderr}");
+}

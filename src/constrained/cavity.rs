@@ -156,7 +156,16 @@ pub fn insert_region(
                         "facet {facet}: a hull face is missing from a cavity triangulation"
                     )));
                 }
-                grow(cdt, outside, side, &mut in_cav, &mut top, &mut bottom)?;
+                if !grow(cdt, outside, side, &mut in_cav, &mut top, &mut bottom) {
+                    // The polygon's sides cannot be told apart here: a point on it,
+                    // near the trouble, separates them.
+                    return Ok(Outcome::NeedsSteiner(steiner_point(
+                        cdt,
+                        tris,
+                        all[m].verts,
+                        normal,
+                    )));
+                }
                 cavity.push(outside);
                 enlarged += 1;
             }
@@ -852,7 +861,9 @@ impl SideDt {
 }
 
 /// Adds tet `t` (outside the cavity, next to side `side`) to the cavity, updating the
-/// boundary faces of both sides.
+/// boundary faces of both sides. False, with the cavity left half grown, if `t` also
+/// touches the other side's boundary: the cavity would wrap around its polygon (seen on
+/// needle polygons billions of times longer than wide, whose sides rounding confuses).
 fn grow(
     cdt: &Cdt,
     t: TetId,
@@ -860,7 +871,7 @@ fn grow(
     in_cav: &mut SlotSet,
     top: &mut Vec<CavFace>,
     bottom: &mut Vec<CavFace>,
-) -> Result<(), MeshError> {
+) -> bool {
     let mesh = &cdt.dt.mesh;
     for i in 0..4 {
         let f = FaceRef::new(t, i);
@@ -872,17 +883,13 @@ fn grow(
             match (in_top, in_bot) {
                 (Some(k), _) => {
                     if side != 0 {
-                        return Err(MeshError::Internal(
-                            "a cavity grew around its polygon".into(),
-                        ));
+                        return false;
                     }
                     top.swap_remove(k);
                 }
                 (None, Some(k)) => {
                     if side != 1 {
-                        return Err(MeshError::Internal(
-                            "a cavity grew around its polygon".into(),
-                        ));
+                        return false;
                     }
                     bottom.swap_remove(k);
                 }
@@ -901,7 +908,7 @@ fn grow(
         }
     }
     in_cav.insert(t);
-    Ok(())
+    true
 }
 
 /// Replaces the cavity's tets by `new_tets`, gluing them to each other and to the tets
