@@ -43,6 +43,10 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
     let (t1, i) = (f.tet(), f.face());
     let g = mesh.adj(f);
     let t2 = g.tet();
+    // A flip never removes a hull tet (the hull is not the flips' to change).
+    if mesh.is_ghost(t1) || mesh.is_ghost(t2) {
+        return None;
+    }
     let v = mesh.verts(t1)[i];
     let w = mesh.verts(t2)[g.face()];
     let s = mesh.face_verts(t1, i);
@@ -74,7 +78,7 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
         let k = neg[0];
         let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
         let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
-        if !mesh.verts(t3).contains(&w) {
+        if mesh.is_ghost(t3) || !mesh.verts(t3).contains(&w) {
             return None;
         }
         return Some(Shape {
@@ -90,6 +94,9 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
         let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
         let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
         let t4 = mesh.adj(FaceRef::new(t2, opposite(t2, s[k])?)).tet();
+        if mesh.is_ghost(t3) || mesh.is_ghost(t4) {
+            return None;
+        }
         let (t3v, t4v) = (mesh.verts(t3), mesh.verts(t4));
         let &u = t3v.iter().find(|&&x| x != e0 && x != e1 && x != v)?;
         if u == w || !t4v.contains(&u) || !t4v.contains(&w) {

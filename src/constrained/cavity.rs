@@ -436,7 +436,8 @@ impl Region {
 /// Does tet `t` have an edge crossing the region?
 fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     let v = cdt.dt.mesh.verts(t);
-    if v[3] == GHOST {
+    // A hull tet never crosses (its ghost vertex is last, unless a flip put it elsewhere).
+    if v.contains(&GHOST) {
         return false;
     }
     let tests = &cdt.crossing_tests;
@@ -593,7 +594,12 @@ fn split_sides(
                     continue;
                 }
                 let g = surface_neighbor(cdt, f, a, b, in_cav)?;
-                let gi = index[&g];
+                // The turn around edge (a, b) ends on a face that is not on the
+                // cavity's boundary: the cavity is pinched there (seen around needle
+                // polygons far out of proportion), and its surface has no two sides.
+                let Some(&gi) = index.get(&g) else {
+                    return Ok(None);
+                };
                 if comp[gi] == usize::MAX {
                     comp[gi] = ncomp;
                     stack.push(gi);
