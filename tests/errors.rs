@@ -629,14 +629,13 @@ fn fuzz_regression_cavity_around_a_needle_polygon() {
     assert!(!stderr.contains("internal error"), "{stderr}");
 }
 
-/// Known bug, found by fuzzing with `-F` (not yet part of `tests/fuzz.rs`): `mpi.off`
-/// with a vertex moved 1.2e21 units out. A Steiner point on a polygon goes into the CDT
-/// (walled cavity, then flips), is refused because a subsegment would be lost, and is
-/// taken back; the mesh's links are broken after that, and a later facet fails with the
-/// internal error "turning around a cavity edge did not end". Run with `--ignored`.
+/// Found by fuzzing with `-F`: `mpi.off` with a vertex moved 1.2e21 units out. A
+/// Steiner point's cavity in the CDT (which is not Delaunay near its constraints) was
+/// pinched, two parts meeting along an edge only; filling it glued the new tets wrongly,
+/// and a later facet failed with an internal error. Such a cavity is now refused like
+/// one that wraps around a subface, and the run ends as with `-C`.
 #[test]
-#[ignore = "known bug: the mesh is corrupted after a refused Steiner point is taken back"]
-fn fuzz_known_bug_refused_point_far_out_corrupts_the_mesh() {
+fn fuzz_regression_pinched_cavity_is_refused() {
     let (code, stderr) = mutated(
         "nonflat/mpi.off",
         "\n-10 10 10\n",

@@ -503,15 +503,38 @@ impl Delaunay {
                         || (b.v[3] != GHOST && Some(self.orientation(b.v)) != reference())
                 }))
         {
-            for i in 0..self.conflict.len() {
-                self.mark[self.conflict[i] as usize] = 0;
-            }
-            for i in 0..self.boundary.len() {
-                self.mark[self.boundary[i].outside.tet() as usize] = 0;
-            }
+            self.abandon_cavity();
             return Ok(Cavity::Wraps);
         }
         Ok(Cavity::Ready)
+    }
+
+    /// Clears the marks of a cavity that will not be filled.
+    pub(crate) fn abandon_cavity(&mut self) {
+        for i in 0..self.conflict.len() {
+            self.mark[self.conflict[i] as usize] = 0;
+        }
+        for i in 0..self.boundary.len() {
+            self.mark[self.boundary[i].outside.tet() as usize] = 0;
+        }
+    }
+
+    /// Whether the cavity's boundary is a closed surface in which every edge joins
+    /// exactly two faces, seen in opposite directions: true of every cavity in a
+    /// Delaunay tetrahedralization, but in a constrained one (not Delaunay near its
+    /// constraints) the tets in conflict can pinch, meeting along an edge only, and
+    /// filling such a cavity would glue the new tets wrongly.
+    pub(crate) fn boundary_is_a_sphere(&self) -> bool {
+        let mut directed: rustc_hash::FxHashSet<(VertexId, VertexId)> =
+            rustc_hash::FxHashSet::default();
+        for b in &self.boundary {
+            for (_, (x, y)) in FAN_EDGES[b.face] {
+                if !directed.insert((b.v[x], b.v[y])) {
+                    return false;
+                }
+            }
+        }
+        directed.iter().all(|&(a, c)| directed.contains(&(c, a)))
     }
 
     /// Replaces the conflict tets by the fan of new tets from the new vertex to the cavity

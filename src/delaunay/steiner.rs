@@ -88,7 +88,11 @@ impl Delaunay {
             return Ok(Walled::Refused);
         }
         let v = self.push_point(p, pert);
-        let found = self.blocked_cavity(v, &blocked);
+        let mut found = self.blocked_cavity(v, &blocked);
+        if matches!(found, Ok(super::Cavity::Ready)) && !self.boundary_is_a_sphere() {
+            self.abandon_cavity();
+            found = Ok(super::Cavity::Wraps);
+        }
         if !matches!(found, Ok(super::Cavity::Ready)) {
             self.points.pop();
             self.orig.pop();
