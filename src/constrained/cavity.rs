@@ -436,7 +436,7 @@ impl Region {
 /// Does tet `t` have an edge crossing the region?
 fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     let v = cdt.dt.mesh.verts(t);
-    // A hull tet never crosses (its ghost vertex is last, unless a flip put it elsewhere).
+    // A hull tet never crosses, wherever its ghost vertex is (see `free::not_delaunay`).
     if v.contains(&GHOST) {
         return false;
     }

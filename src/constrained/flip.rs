@@ -626,11 +626,12 @@ impl<'a> Flipper<'a> {
                 if !self.is_crossing(&[tv[0], tv[1], tv[2], tv[3], apex]) {
                     continue;
                 }
-                let time = self.flip_time(f);
+                let verts = self.certificate_verts(f);
+                let time = self.time_from(verts);
                 let now = self.time_of(cur);
                 if cross_sign(&now, &time, &self.lift, &mut self.cmp) > 0 {
                     self.counts.not_regular += 1;
-                    self.push_event(f, time, true);
+                    self.push_event(f, verts, time, true);
                 }
             }
         }
@@ -669,13 +670,6 @@ impl<'a> Flipper<'a> {
         l && r
     }
 
-    /// What the flip certificate of face `f` needs (seen from its tet, apex of the other
-    /// tet last): the five points, their perturbation indices, which are left, and their
-    /// heights.
-    fn certificate(&self, f: FaceRef) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
-        self.certificate_of(self.certificate_verts(f))
-    }
-
     /// The certificate's five vertices: face `f` seen from its tet, then the apices of
     /// its tet and of the other.
     fn certificate_verts(&self, f: FaceRef) -> [VertexId; 5] {
@@ -687,7 +681,8 @@ impl<'a> Flipper<'a> {
         [s[0], s[1], s[2], v, w]
     }
 
-    /// [`Flipper::certificate`] of five vertices in certificate order.
+    /// What the flip certificate of five vertices in certificate order needs: their
+    /// points, perturbation indices, which are left, and their heights.
     fn certificate_of(&self, ids: [VertexId; 5]) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
         let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
@@ -696,39 +691,35 @@ impl<'a> Flipper<'a> {
         (pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
     }
 
+    /// The flip certificate of five vertices in certificate order.
+    fn time_from(&self, verts: [VertexId; 5]) -> FlipTime {
+        let (pts, orig, left, heights) = self.certificate_of(verts);
+        FlipTime::new(pts, orig, left, heights)
+    }
+
     /// The flip time of event `e`, computed again from its five vertices.
     fn time_of(&self, e: u32) -> FlipTime {
-        let (pts, orig, left, heights) = self.certificate_of(self.events[e as usize].verts);
-        FlipTime::new(pts, orig, left, heights)
-    }
-
-    /// The flip certificate of face `f`, if it ever flips.
-    fn flip_time_if_flips(&self, f: FaceRef) -> Option<FlipTime> {
-        let (pts, orig, left, heights) = self.certificate(f);
-        FlipTime::if_flips(&self.lift, pts, orig, left, heights)
-    }
-
-    /// The flip certificate of face `f`.
-    fn flip_time(&self, f: FaceRef) -> FlipTime {
-        let (pts, orig, left, heights) = self.certificate(f);
-        FlipTime::new(pts, orig, left, heights)
+        self.time_from(self.events[e as usize].verts)
     }
 
     /// Queues the flip of crossing face `f` if it ever happens.
     fn certify(&mut self, f: FaceRef) {
-        if let Some(time) = self.flip_time_if_flips(f) {
-            self.push_event(f, time, false);
+        let verts = self.certificate_verts(f);
+        let (pts, orig, left, heights) = self.certificate_of(verts);
+        if let Some(time) = FlipTime::if_flips(&self.lift, pts, orig, left, heights) {
+            self.push_event(f, verts, time, false);
         }
     }
 
-    fn push_event(&mut self, f: FaceRef, time: FlipTime, forced: bool) {
+    /// Queues the flip of face `f`, whose certificate `time` is of the five `verts`.
+    fn push_event(&mut self, f: FaceRef, verts: [VertexId; 5], time: FlipTime, forced: bool) {
         let t2 = self.cdt.dt.mesh.adj(f).tet();
         let e = Event {
             face: f,
             t2,
             g1: self.gens.of(f.tet()),
             g2: self.gens.of(t2),
-            verts: self.certificate_verts(f),
+            verts,
         };
         let (lo, hi) = time.interval();
         let idx = match self.free_events.pop() {
