@@ -4,7 +4,8 @@
 //!   seed (so a new format is fuzzed as soon as a sample of it is added). Proptest applies
 //!   byte flips, truncations, random tokens (huge, negative, NaN, `#`), dropped and
 //!   repeated lines; the result goes through the reader and, when it parses, through the
-//!   checks, `-d` and the whole `-p` pipeline (or the point-set pipeline).
+//!   checks, `-d` and the whole `-p` pipeline (or the point-set pipeline), with facet
+//!   insertion by cavities (`-C`) or, every other PLC, by flips (`-F`).
 //! * **Random PLCs.** Random points (on a small grid, so degeneracies are common) and
 //!   random triangles; unit cubes with perturbed vertices (which must mesh and pass the
 //!   checker), with facets dropped (which must be refused as invalid, not fail).
@@ -21,6 +22,7 @@ use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use std::sync::mpsc;
 use std::time::Duration;
 use tetcdt::error::{Error, InputError, MeshError};
+use tetcdt::options::FacetAlgo;
 use tetcdt::plc::{Facet, Plc};
 use tetcdt::Options;
 
@@ -67,13 +69,25 @@ fn acceptable(e: &Error) -> Result<(), String> {
 static MESHED: AtomicUsize = AtomicUsize::new(0);
 static REFUSED: AtomicUsize = AtomicUsize::new(0);
 
-/// Meshes `plc` (as a PLC when it has facets) and runs `-d`; checks the error kinds.
+/// PLCs meshed so far: every other one goes by flips.
+static PLCS: AtomicUsize = AtomicUsize::new(0);
+
+/// Meshes `plc` (as a PLC when it has facets, by cavities or, every other PLC, by flips:
+/// both in one case could pass the deadline where each alone does not) and runs `-d`;
+/// checks the error kinds.
 fn mesh_any(plc: &Plc) -> Result<Option<tetcdt::Meshed>, String> {
     let _ = tetcdt::precheck::detect::detect(plc);
+    let is_plc = !plc.facets.is_empty();
+    let flips = is_plc && PLCS.fetch_add(1, Relaxed) % 2 == 1;
     let opts = Options {
-        plc: !plc.facets.is_empty(),
+        plc: is_plc,
         quiet: true,
         max_steiner: Some(20_000),
+        facet_algo: if flips {
+            FacetAlgo::Flip
+        } else {
+            FacetAlgo::Cavity
+        },
         ..Default::default()
     };
     match tetcdt::tetrahedralize(plc, &opts) {
@@ -86,7 +100,9 @@ fn mesh_any(plc: &Plc) -> Result<Option<tetcdt::Meshed>, String> {
             if std::env::var_os("TETCDT_FUZZ_VERBOSE").is_some() {
                 eprintln!("refused: {e}");
             }
-            acceptable(&e).map(|()| None)
+            acceptable(&e)
+                .map(|()| None)
+                .map_err(|m| if flips { format!("with -F: {m}") } else { m })
         }
     }
 }

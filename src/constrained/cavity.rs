@@ -363,7 +363,19 @@ pub(crate) struct Region {
     pub(crate) verts: FxHashSet<VertexId>,
     boundary: FxHashSet<(VertexId, VertexId)>,
     boxes: Vec<[[f64; 3]; 2]>,
+    /// For large regions, each vertex's side of each triangle's plane once computed
+    /// ([`UNKNOWN`] before): neighbouring tets share vertices, and a region of
+    /// thousands of sliver triangles fanned from a far vertex (found by fuzzing), whose
+    /// boxes all overlap, cost a minute of exact orientations without it.
+    sides: std::cell::RefCell<FxHashMap<VertexId, Box<[i8]>>>,
 }
+
+/// A side not computed yet.
+const UNKNOWN: i8 = 2;
+/// Regions with at least this many triangles cache their vertices' sides.
+const CACHE_SIDES: usize = 64;
+/// The most side entries cached per region (bytes); past it, sides are recomputed.
+const MAX_SIDES: usize = 1 << 26;
 
 impl Region {
     /// The region of triangles `tris`.
@@ -402,22 +414,45 @@ impl Region {
             verts,
             boundary,
             boxes,
+            sides: Default::default(),
         }
+    }
+
+    /// The sign of `orient3d` of triangle `k` and vertex `v`, cached for large regions.
+    fn side(&self, pts: &[Point], k: usize, v: VertexId) -> i8 {
+        let compute = || {
+            let [a, b, c] = self.tris[k].map(|x| &pts[x as usize]);
+            let o = orient3d(a, b, c, &pts[v as usize]);
+            (o > 0.0) as i8 - (o < 0.0) as i8
+        };
+        if self.tris.len() < CACHE_SIDES {
+            return compute();
+        }
+        let mut sides = self.sides.borrow_mut();
+        if !sides.contains_key(&v) && (sides.len() + 1) * self.tris.len() > MAX_SIDES {
+            return compute();
+        }
+        let row = sides
+            .entry(v)
+            .or_insert_with(|| vec![UNKNOWN; self.tris.len()].into_boxed_slice());
+        if row[k] == UNKNOWN {
+            row[k] = compute();
+        }
+        row[k]
     }
 
     /// Does the open segment `pq` cross the region's interior?
     fn crossed_by(&self, pts: &[Point], p: VertexId, q: VertexId) -> bool {
         let (pp, pq) = (&pts[p as usize], &pts[q as usize]);
-        for (t, bx) in self.tris.iter().zip(&self.boxes) {
+        for (k, (t, bx)) in self.tris.iter().zip(&self.boxes).enumerate() {
             if (0..3).any(|k| pp[k].max(pq[k]) < bx[0][k] || pp[k].min(pq[k]) > bx[1][k]) {
                 continue;
             }
-            let [a, b, c] = t.map(|v| &pts[v as usize]);
-            let o1 = orient3d(a, b, c, pp);
-            let o2 = orient3d(a, b, c, pq);
-            if !((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) {
+            let (o1, o2) = (self.side(pts, k, p), self.side(pts, k, q));
+            if o1 * o2 >= 0 {
                 continue;
             }
+            let [a, b, c] = t.map(|v| &pts[v as usize]);
             let s = [
                 orient3d(pp, pq, a, b),
                 orient3d(pp, pq, b, c),
@@ -1068,4 +1103,65 @@ fn circumcenter(cdt: &Cdt, f: [VertexId; 3]) -> Point {
         ];
     }
     std::array::from_fn(|k| a[k] + (ab2 * acn[k] + ac2 * nab[k]) / (2.0 * nn))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::delaunay::Delaunay;
+    use crate::geom::lcg;
+
+    /// A region large enough to cache its vertices' sides (a fan of slivers from a far
+    /// vertex, as fuzzing made) answers every segment as the plain exact test does,
+    /// asked in any order and again.
+    #[test]
+    fn cached_sides_answer_as_the_plain_test() {
+        let mut s = 5u64;
+        let mut pts: Vec<Point> = vec![[1e12, 0.3, 0.1]];
+        let ring = 2 * CACHE_SIDES;
+        for k in 0..ring {
+            let a = k as f64 / ring as f64 * std::f64::consts::TAU;
+            pts.push([a.cos(), a.sin(), 1e-3 * (lcg(&mut s) - 0.5)]);
+        }
+        while pts.len() < ring + 200 {
+            pts.push([0, 0, 0].map(|_| 2.0 * lcg(&mut s) - 1.0));
+        }
+        let dt = Delaunay::build(&pts).unwrap().dt;
+        let inv = dt.internal_ids(pts.len());
+        let cdt = Cdt::new(dt);
+        let tris: Vec<[VertexId; 3]> = (0..ring)
+            .map(|k| [inv[0], inv[1 + k], inv[1 + (k + 1) % ring]])
+            .collect();
+        let region = Region::new(&cdt, &tris);
+        assert!(region.tris.len() >= CACHE_SIDES);
+        let plain = |p: VertexId, q: VertexId| {
+            let pt = |v: VertexId| &cdt.dt.points[v as usize];
+            tris.iter().any(|t| {
+                let [a, b, c] = t.map(pt);
+                let (o1, o2) = (orient3d(a, b, c, pt(p)), orient3d(a, b, c, pt(q)));
+                if !((o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)) {
+                    return false;
+                }
+                let e = [
+                    orient3d(pt(p), pt(q), a, b),
+                    orient3d(pt(p), pt(q), b, c),
+                    orient3d(pt(p), pt(q), c, a),
+                ];
+                !(e.iter().any(|&x| x > 0.0) && e.iter().any(|&x| x < 0.0))
+            })
+        };
+        let n = pts.len() as f64;
+        let mut crossing = 0;
+        for _ in 0..2000 {
+            let p = (lcg(&mut s) * n) as VertexId % pts.len() as VertexId;
+            let q = (lcg(&mut s) * n) as VertexId % pts.len() as VertexId;
+            if p == q {
+                continue;
+            }
+            let want = plain(p, q);
+            crossing += want as usize;
+            assert_eq!(region.crossed_by(&cdt.dt.points, p, q), want, "{p} {q}");
+        }
+        assert!(crossing > 100, "{crossing}");
+    }
 }

@@ -486,22 +486,15 @@ impl Delaunay {
                 });
             }
         }
-        // A cavity that reached both sides of a blocked face would destroy it; one that
+        // A cavity that reached both sides of a blocked face would destroy it. (One that
         // wrapped around a blocked face into tets hidden from the new vertex would make
-        // inverted tets (real tets all have the orientation of the real tets it removes).
-        let reference = || {
-            self.conflict
-                .iter()
-                .map(|&t| self.mesh.verts(t))
-                .find(|v| v[3] != GHOST)
-                .map(|v| self.orientation(v))
-        };
+        // inverted tets: `fill_is_positive` refuses it.)
         if walled
             && (wraps
-                || self.boundary.iter().any(|b| {
-                    self.mark[b.outside.tet() as usize] == IN_CONFLICT
-                        || (b.v[3] != GHOST && Some(self.orientation(b.v)) != reference())
-                }))
+                || self
+                    .boundary
+                    .iter()
+                    .any(|b| self.mark[b.outside.tet() as usize] == IN_CONFLICT))
         {
             self.abandon_cavity();
             return Ok(Cavity::Wraps);
@@ -535,6 +528,17 @@ impl Delaunay {
             }
         }
         directed.iter().all(|&(a, c)| directed.contains(&(c, a)))
+    }
+
+    /// Whether every real tet the cavity's fill would make is positively oriented. True of
+    /// every Delaunay cavity, but in a constrained tetrahedralization a cavity need not be
+    /// seen whole from the new point: it may wrap around a wall, or (found by fuzzing
+    /// `-F`, with no wall met) grow through tets that are not Delaunay. Filling it would
+    /// make inverted tets that overlap others.
+    pub(crate) fn fill_is_positive(&self) -> bool {
+        self.boundary
+            .iter()
+            .all(|b| b.v[3] == GHOST || self.orientation(b.v) > 0)
     }
 
     /// Replaces the conflict tets by the fan of new tets from the new vertex to the cavity

@@ -76,8 +76,9 @@ impl Delaunay {
     }
 
     /// Inserts a Steiner point into a constrained tetrahedralization with a cavity walled
-    /// in by the `blocked` faces, unless the cavity would wrap around one of them. The
-    /// change is recorded so that [`Delaunay::undo`] can take it back.
+    /// in by the `blocked` faces, unless the cavity would wrap around one of them, pinch,
+    /// or not be seen whole from the point. The change is recorded so that
+    /// [`Delaunay::undo`] can take it back.
     pub fn insert_walled(
         &mut self,
         p: Point,
@@ -89,7 +90,8 @@ impl Delaunay {
         }
         let v = self.push_point(p, pert);
         let mut found = self.blocked_cavity(v, &blocked);
-        if matches!(found, Ok(super::Cavity::Ready)) && !self.boundary_is_a_sphere() {
+        let ready = matches!(found, Ok(super::Cavity::Ready));
+        if ready && !(self.boundary_is_a_sphere() && self.fill_is_positive()) {
             self.abandon_cavity();
             found = Ok(super::Cavity::Wraps);
         }

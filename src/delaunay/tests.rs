@@ -285,3 +285,115 @@ fn walled_insertions_are_undone_exactly() {
         }
     }
 }
+
+/// In a tetrahedralization that is not Delaunay (as a CDT is not, near its constraints)
+/// a cavity grown by the insphere test need not be seen whole from the new point, even
+/// with no wall met: such an insertion is refused, leaving the mesh as it was, and every
+/// accepted one makes positive tets. The mesh here is a Delaunay one with a vertex moved
+/// (its tets staying positive), and the points go near that vertex.
+#[test]
+fn cavities_not_seen_whole_from_the_point_are_refused() {
+    let pts = random_points(200, 5);
+    let mut s = 91u64;
+    let (mut refused, mut inserted) = (0, 0);
+    for k in 0..2000 {
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let v = (lcg(&mut s) * pts.len() as f64) as usize % pts.len();
+        let on_hull = dt
+            .mesh
+            .live_tets()
+            .any(|t| dt.mesh.is_ghost(t) && dt.mesh.verts(t).contains(&(v as VertexId)));
+        if on_hull {
+            continue;
+        }
+        let step = 10f64.powf(-1.5 - 1.5 * lcg(&mut s));
+        let at = dt.points[v];
+        let moved: Point = std::array::from_fn(|d| at[d] + step * (lcg(&mut s) - 0.5));
+        dt.points[v] = moved;
+        let positive = |dt: &Delaunay| {
+            dt.mesh.real_tets().all(|t| {
+                let q = dt.mesh.verts(t).map(|x| dt.pt(x));
+                orient3d(q[0], q[1], q[2], q[3]) > 0.0
+            })
+        };
+        if !positive(&dt) {
+            continue;
+        }
+        let tets_before = sorted_tets(&dt);
+        let p: Point = std::array::from_fn(|d| moved[d] + 2.0 * step * (lcg(&mut s) - 0.5));
+        let n = dt.points.len();
+        match dt.insert_walled(p, n as u32, |_, _| false).unwrap() {
+            Walled::Inserted { .. } => {
+                inserted += 1;
+                dt.mesh.check_links().unwrap();
+                assert!(positive(&dt), "round {k}");
+            }
+            Walled::Refused => {
+                refused += 1;
+                dt.mesh.check_links().unwrap();
+                assert_eq!(dt.points.len(), n);
+                assert_eq!(sorted_tets(&dt), tets_before, "round {k}");
+            }
+            Walled::OnVertex => panic!("round {k}"),
+        }
+    }
+    assert!(
+        refused > 5 && inserted > 5,
+        "{refused} refused, {inserted} inserted"
+    );
+}
+
+/// The same with walls: the point in one tet near an edge of the face it shares with a
+/// neighbour, every other face a wall. Where the two tets are not convex together, the
+/// point does not see the neighbour's face at that edge.
+#[test]
+fn walled_cavities_not_seen_whole_from_the_point_are_refused() {
+    let pts = random_points(200, 5);
+    let mut s = 91u64;
+    let (mut refused, mut inserted) = (0, 0);
+    for k in 0..300 {
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let tets_before = sorted_tets(&dt);
+        let real: Vec<TetId> = dt.mesh.real_tets().collect();
+        let t = real[(lcg(&mut s) * real.len() as f64) as usize % real.len()];
+        let i = (lcg(&mut s) * 4.0) as usize % 4;
+        if dt.mesh.is_ghost(dt.mesh.adj(FaceRef::new(t, i)).tet()) {
+            continue;
+        }
+        let f = dt.mesh.face_verts(t, i);
+        let apex = *dt.pt(dt.mesh.verts(t)[i]);
+        let e = (lcg(&mut s) * 3.0) as usize % 3;
+        let c: Point = std::array::from_fn(|d| (dt.pt(f[e])[d] + dt.pt(f[(e + 1) % 3])[d]) / 2.0);
+        let step = 10f64.powf(-1.0 - 3.0 * lcg(&mut s));
+        let p: Point = std::array::from_fn(|d| c[d] + step * (apex[d] - c[d]));
+        let mut shared = f;
+        shared.sort_unstable();
+        let blocked = |v: [VertexId; 4], j: usize| {
+            let mut face = FACE_VERTS[j].map(|x| v[x]);
+            face.sort_unstable();
+            face != shared
+        };
+        let n = dt.points.len();
+        match dt.insert_walled(p, n as u32, blocked).unwrap() {
+            Walled::Inserted { .. } => {
+                inserted += 1;
+                dt.mesh.check_links().unwrap();
+                for t in dt.mesh.real_tets() {
+                    let v = dt.mesh.verts(t).map(|x| dt.pt(x));
+                    assert!(orient3d(v[0], v[1], v[2], v[3]) > 0.0, "round {k}");
+                }
+            }
+            Walled::Refused => {
+                refused += 1;
+                dt.mesh.check_links().unwrap();
+                assert_eq!(dt.points.len(), n);
+                assert_eq!(sorted_tets(&dt), tets_before, "round {k}");
+            }
+            Walled::OnVertex => panic!("round {k}"),
+        }
+    }
+    assert!(
+        refused > 10 && inserted > 10,
+        "{refused} refused, {inserted} inserted"
+    );
+}
