@@ -418,16 +418,13 @@ impl Region {
         }
     }
 
-    /// The sign of `orient3d` of triangle `k` and vertex `v`, cached for large regions.
+    /// The sign of `orient3d` of triangle `k` and vertex `v`, cached.
     fn side(&self, pts: &[Point], k: usize, v: VertexId) -> i8 {
         let compute = || {
             let [a, b, c] = self.tris[k].map(|x| &pts[x as usize]);
             let o = orient3d(a, b, c, &pts[v as usize]);
             (o > 0.0) as i8 - (o < 0.0) as i8
         };
-        if self.tris.len() < CACHE_SIDES {
-            return compute();
-        }
         let mut sides = self.sides.borrow_mut();
         if !sides.contains_key(&v) && (sides.len() + 1) * self.tris.len() > MAX_SIDES {
             return compute();
@@ -444,15 +441,21 @@ impl Region {
     /// Does the open segment `pq` cross the region's interior?
     fn crossed_by(&self, pts: &[Point], p: VertexId, q: VertexId) -> bool {
         let (pp, pq) = (&pts[p as usize], &pts[q as usize]);
+        let cached = self.tris.len() >= CACHE_SIDES;
         for (k, (t, bx)) in self.tris.iter().zip(&self.boxes).enumerate() {
             if (0..3).any(|k| pp[k].max(pq[k]) < bx[0][k] || pp[k].min(pq[k]) > bx[1][k]) {
                 continue;
             }
-            let (o1, o2) = (self.side(pts, k, p), self.side(pts, k, q));
-            if o1 * o2 >= 0 {
+            let [a, b, c] = t.map(|v| &pts[v as usize]);
+            let straddles = if cached {
+                self.side(pts, k, p) * self.side(pts, k, q) < 0
+            } else {
+                let (o1, o2) = (orient3d(a, b, c, pp), orient3d(a, b, c, pq));
+                (o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)
+            };
+            if !straddles {
                 continue;
             }
-            let [a, b, c] = t.map(|v| &pts[v as usize]);
             let s = [
                 orient3d(pp, pq, a, b),
                 orient3d(pp, pq, b, c),
