@@ -426,12 +426,14 @@ impl Region {
             (o > 0.0) as i8 - (o < 0.0) as i8
         };
         let mut sides = self.sides.borrow_mut();
-        if !sides.contains_key(&v) && (sides.len() + 1) * self.tris.len() > MAX_SIDES {
-            return compute();
-        }
-        let row = sides
-            .entry(v)
-            .or_insert_with(|| vec![UNKNOWN; self.tris.len()].into_boxed_slice());
+        let full = (sides.len() + 1) * self.tris.len() > MAX_SIDES;
+        let row = match sides.entry(v) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(_) if full => return compute(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(vec![UNKNOWN; self.tris.len()].into_boxed_slice())
+            }
+        };
         if row[k] == UNKNOWN {
             row[k] = compute();
         }
@@ -474,8 +476,7 @@ impl Region {
 /// Does tet `t` have an edge crossing the region?
 fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     let v = cdt.dt.mesh.verts(t);
-    // A hull tet never crosses, wherever its ghost vertex is (see `free::not_delaunay`).
-    if v.contains(&GHOST) {
+    if v[3] == GHOST {
         return false;
     }
     let tests = &cdt.crossing_tests;
