@@ -404,13 +404,29 @@ impl Delaunay {
     /// Inserts vertex `pv` (already in `points`). Returns `Ok(false)` if it coincides with
     /// an existing vertex and was skipped.
     pub fn insert(&mut self, pv: VertexId) -> Result<bool, MeshError> {
+        self.insert_noting(pv, None)
+    }
+
+    /// [`Delaunay::insert`], also listing in `removed` (when given) the vertices of the
+    /// tets the insertion replaced.
+    fn insert_noting(
+        &mut self,
+        pv: VertexId,
+        removed: Option<&mut Vec<[VertexId; 4]>>,
+    ) -> Result<bool, MeshError> {
         match self.blocked_cavity(pv, |_, _| false)? {
             Cavity::OnVertex => Ok(false),
             // Nothing is blocked, so the cavity cannot wrap around anything.
             Cavity::Wraps => Err(MeshError::Internal(
                 "the cavity of a vertex wraps around a constraint".into(),
             )),
-            Cavity::Ready => self.fill_cavity(),
+            Cavity::Ready => {
+                if let Some(removed) = removed {
+                    removed.clear();
+                    removed.extend(self.conflict.iter().map(|&t| self.mesh.verts(t)));
+                }
+                self.fill_cavity()
+            }
         }
     }
 

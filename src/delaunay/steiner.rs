@@ -38,13 +38,24 @@ impl Delaunay {
     /// Inserts a new point with perturbation (and output) index `pert`, which must exceed
     /// every index in use. Returns its vertex id, or `None` if it coincides with a vertex.
     pub fn insert_steiner(&mut self, p: Point, pert: u32) -> Result<Option<VertexId>, MeshError> {
+        self.insert_steiner_noting(p, pert, None)
+    }
+
+    /// [`Delaunay::insert_steiner`], also listing in `removed` (when given) the vertices of
+    /// the tets the insertion replaced.
+    pub fn insert_steiner_noting(
+        &mut self,
+        p: Point,
+        pert: u32,
+        removed: Option<&mut Vec<[VertexId; 4]>>,
+    ) -> Result<Option<VertexId>, MeshError> {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(MeshError::Internal(format!(
                 "Steiner point {p:?} is not finite"
             )));
         }
         let v = self.push_point(p, pert);
-        if !self.insert(v)? {
+        if !self.insert_noting(v, removed)? {
             self.points.pop();
             self.orig.pop();
             return Ok(None);
