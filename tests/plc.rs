@@ -582,6 +582,54 @@ fn flat_tets_get_free_points_inserted_into_the_cdt() {
     }
 }
 
+#[test]
+fn flat_tets_left_on_a_facet_are_counted_and_reported() {
+    // anchor.off's flat tets need a free point. With -S leaving no room for one, the flat
+    // tet stays: the run still succeeds, but says so (a warning, and the figure), where
+    // it used to say nothing; with room, nothing is left and nothing is said.
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/anchor.off");
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("s.json");
+    let json_arg = json.to_str().unwrap();
+    let prefix = dir.path().join("a");
+    let (code, err) = run(&m, &prefix, &["-p", "--stats-json", json_arg]);
+    assert_eq!(code, 0, "{err}");
+    let stats = std::fs::read_to_string(&json).unwrap();
+    assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{stats}");
+    assert!(!err.contains("flat tet"), "{err}");
+    let all = json_number(&stats, "steiner_points");
+    let free = json_number(&stats, "free_steiner_points");
+    assert!(free >= 1, "{stats}");
+    // Fewer Steiner points allowed: the first limit that still meshes, with no room for
+    // a free point, leaves a flat tet (a limit too low for the segments fails instead).
+    let mut seen = false;
+    for limit in (all.saturating_sub(free + 4)..all).rev() {
+        let (code, err) = run(
+            &m,
+            &prefix,
+            &["-p", &format!("-S{limit}"), "--stats-json", json_arg],
+        );
+        if code != 0 {
+            continue;
+        }
+        let stats = std::fs::read_to_string(&json).unwrap();
+        if json_number(&stats, "free_steiner_points") > 0 {
+            continue;
+        }
+        let left = json_number(&stats, "flat_tets_left");
+        assert!(left >= 1, "-S{limit}: {stats}");
+        assert!(
+            err.contains(&format!(
+                "{left} flat tet(s) with all four vertices on one facet"
+            )),
+            "-S{limit}: {err}"
+        );
+        seen = true;
+        break;
+    }
+    assert!(seen, "no limit below {all} meshed without free points");
+}
+
 /// The number after `"key":` in a one-line JSON object.
 fn json_number(json: &str, key: &str) -> usize {
     let at = json

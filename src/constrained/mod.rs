@@ -130,6 +130,8 @@ pub struct PlcStats {
     pub facet_steiner_points: usize,
     /// Of those, the free ones inside the domain (for flat tets at steps of facets).
     pub free_steiner_points: usize,
+    /// Flat tets left with all four vertices on one facet (no free point removed them).
+    pub flat_tets_left: usize,
     /// Output tets.
     pub output_tets: usize,
     /// Output subpolygons (triangles on input polygons).
@@ -334,6 +336,16 @@ pub fn mesh_plc_with_progress(
                 let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
                 stats.facet_steiner_points += facet_points.len() - free;
                 stats.free_steiner_points += free;
+                let (flat, first) = built.flat_left;
+                stats.flat_tets_left = flat;
+                if let Some(f) = first.filter(|_| flat > 0) {
+                    warnings.push(format!(
+                        "{flat} flat tet(s) with all four vertices on one facet remain, the \
+                         first on facet {}: steps or dents of facets that are not flat, which \
+                         no free Steiner point could remove (checks for shim tets flag them)",
+                        facet_name(plc, &merged.facets[f as usize])
+                    ));
+                }
                 let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
                 return Ok(PlcMesh {
                     mesh,
@@ -383,6 +395,9 @@ struct Built {
     seg_markers: FxHashMap<(VertexId, VertexId), i32>,
     /// The CDT's carving, if one was made since it last changed.
     carved: Option<Carved>,
+    /// How many flat tets lie on one facet (of the all-merged facets), and the facet of
+    /// the first.
+    flat_left: (usize, Option<u32>),
 }
 
 /// A Steiner point found by an earlier attempt: (merged facet or [`FREE_POINT`], point).
@@ -630,23 +645,17 @@ fn attempt(
     }
 
     stats.free_steiner_points = 0;
+    let domain = slivers::Domain {
+        holes: &plc.holes,
+        regions: &plc.regions,
+        keep_hull: opts.keep_hull,
+    };
+    // The flat tets left on facets, when known (`None` after points went in).
+    let mut flat_left: Option<(usize, Option<u32>)> = None;
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
-        let domain = slivers::Domain {
-            holes: &plc.holes,
-            regions: &plc.regions,
-            keep_hull: opts.keep_hull,
-        };
         // Free points go straight into the CDT (`free.rs`), round after round; only if
         // none of a round's can does the construction start again with them.
-        // The input ends of the segment of each Steiner point on one, which name the
-        // facets a flat tet of such points may lie on.
-        let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
-        for chain in subsegs.chains.iter().filter(|c| c.len() > 2) {
-            let ends = [chain[0], chain[chain.len() - 1]].map(|x| cdt.dt.orig[x as usize]);
-            for &v in &chain[1..chain.len() - 1] {
-                seg_ends.insert(v, ends);
-            }
-        }
+        let seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
         let mut stuck = Vec::new();
         for _ in 0..MAX_FREE_ROUNDS {
             let found = slivers::free_points(
@@ -657,6 +666,7 @@ fn attempt(
                 &domain,
                 &mut carved,
             );
+            flat_left = Some(found.found);
             let free = found.points;
             stuck = found.stuck;
             if debug() && !free.is_empty() {
@@ -674,6 +684,7 @@ fn attempt(
             stats.free_steiner_points += added;
             if added > 0 {
                 carved = None;
+                flat_left = None;
                 continue;
             }
             // None fits into the CDT as it stands: the construction starts again with
@@ -711,11 +722,39 @@ fn attempt(
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
+    let flat_left = match flat_left {
+        Some(known) => known,
+        None => {
+            let seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
+            slivers::flat_left(
+                &mut cdt,
+                merged,
+                &plc.points,
+                &seg_ends,
+                &domain,
+                &mut carved,
+            )
+        }
+    };
     Ok(Attempt::Done(Box::new(Built {
         cdt,
         seg_markers,
         carved,
+        flat_left,
     })))
+}
+
+/// The input ends of the segment of each Steiner point on one (`orig` maps vertices to
+/// input indices), which name the facets a flat tet of such points may lie on.
+fn segment_ends(subsegs: &segments::Subsegments, orig: &[u32]) -> FxHashMap<VertexId, [u32; 2]> {
+    let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
+    for chain in subsegs.chains.iter().filter(|c| c.len() > 2) {
+        let ends = [chain[0], chain[chain.len() - 1]].map(|x| orig[x as usize]);
+        for &v in &chain[1..chain.len() - 1] {
+            seg_ends.insert(v, ends);
+        }
+    }
+    seg_ends
 }
 
 /// For each flat tet, the split of its longest edge that is a subsegment, as (segment,
@@ -1274,6 +1313,7 @@ fn finish(
         mut cdt,
         seg_markers,
         carved,
+        flat_left: _,
     } = built;
     let t = Instant::now();
     let carved =

@@ -58,19 +58,28 @@ pub(crate) struct FlatTets {
     /// The kept flat tets for which no free vertex was found (their circumspheres lie
     /// within the facet's slab), by their vertices.
     pub stuck: Vec<[crate::mesh::VertexId; 4]>,
+    /// How many flat tets on facets there are, and the facet of the first.
+    pub found: (usize, Option<u32>),
 }
 
-/// Free vertices that remove the flat tets lying on one facet, one per such tet, and
-/// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
-/// if made.
-pub(crate) fn free_points(
+/// The flat tets that carving keeps and that lie on one facet, each with that facet; the
+/// slabs built on the way (per facet, `None` where not yet built); and the kept mask.
+type Found = (
+    Vec<(crate::mesh::TetId, u32)>,
+    Vec<Option<Option<Slab>>>,
+    Vec<bool>,
+);
+
+/// Finds the flat tets that carving keeps and that lie on one facet (see [`Found`]);
+/// `None` if there are none. `carved` is the CDT's carving if known, and is set if made.
+fn find_flat(
     cdt: &mut Cdt,
     prep: &PreparedPlc,
     input: &[Point],
     seg_ends: &FxHashMap<VertexId, [u32; 2]>,
     domain: &Domain<'_>,
     carved: &mut Option<Carved>,
-) -> FlatTets {
+) -> Option<Found> {
     // A tet can lie on one facet only if it has a Steiner point (which may lie in a
     // slab), or if its four input vertices share a facet, which then has four or more:
     // that rules out most tets before any geometry.
@@ -96,7 +105,7 @@ pub(crate) fn free_points(
         .filter(|&t| is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize])))
         .collect();
     if flat_tets.is_empty() {
-        return FlatTets::default();
+        return None;
     }
     // Only kept tets matter, and the carving is needed anyway (the output reuses it):
     // flat tets outside the domain, often many, are dropped before any facet is looked at.
@@ -108,16 +117,10 @@ pub(crate) fn free_points(
         .filter(|&t| kept[t as usize])
         .collect();
     if flat_tets.is_empty() {
-        return FlatTets::default();
+        return None;
     }
     let diag = diagonal(input);
     // Which facets each input vertex is on, as lists per vertex (one flat array).
-    let ring_verts = |f: &super::prepare::MergedFacet| -> Vec<u32> {
-        let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
-        verts.sort_unstable();
-        verts.dedup();
-        verts
-    };
     let on_facets = crate::mesh::VertexLists::new(
         n_input,
         prep.facets
@@ -128,34 +131,7 @@ pub(crate) fn free_points(
     );
     let facets_of = |v: u32| on_facets.of(v);
     // Slabs are built on demand: most facets never hold a flat tet.
-    let slab_of = |fi: usize| -> Option<Slab> {
-        let f = &prep.facets[fi];
-        let verts = ring_verts(f);
-        if verts.is_empty() || f.normal == [0.0; 3] {
-            return None;
-        }
-        let k = verts.len() as f64;
-        let mean: Point =
-            std::array::from_fn(|a| verts.iter().map(|&v| input[v as usize][a]).sum::<f64>() / k);
-        let mut slab = Slab {
-            normal: f.normal,
-            mean,
-            tol: 0.0,
-            lo: [f64::INFINITY; 3],
-            hi: [f64::NEG_INFINITY; 3],
-        };
-        let mut dev = 0.0f64;
-        for &v in &verts {
-            let p = &input[v as usize];
-            dev = dev.max(slab.height(p).abs());
-            for (a, &x) in p.iter().enumerate() {
-                slab.lo[a] = slab.lo[a].min(x);
-                slab.hi[a] = slab.hi[a].max(x);
-            }
-        }
-        slab.tol = (1e-10 * diag).max(4.0 * dev);
-        Some(slab)
-    };
+    let slab_of = |fi: usize| slab_of(prep, input, diag, fi);
     let mut slab_cache: Vec<Option<Option<Slab>>> = Vec::new();
     slab_cache.resize_with(prep.facets.len(), || None);
     let mut on = |orig: u32, p: &Point, f: u32| -> bool {
@@ -206,16 +182,50 @@ pub(crate) fn free_points(
             flat.push((t, f));
         }
     }
-    if flat.is_empty() {
+    (!flat.is_empty()).then_some((flat, slab_cache, kept))
+}
+
+/// How many flat tets that carving keeps lie on one facet, and the facet of the first:
+/// what is left once no free point removes any more. `carved` as in [`free_points`].
+pub(crate) fn flat_left(
+    cdt: &mut Cdt,
+    prep: &PreparedPlc,
+    input: &[Point],
+    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
+    domain: &Domain<'_>,
+    carved: &mut Option<Carved>,
+) -> (usize, Option<u32>) {
+    find_flat(cdt, prep, input, seg_ends, domain, carved).map_or((0, None), |(flat, _, _)| {
+        (flat.len(), flat.first().map(|x| x.1))
+    })
+}
+
+/// Free vertices that remove the flat tets lying on one facet, one per such tet, and
+/// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
+/// if made.
+pub(crate) fn free_points(
+    cdt: &mut Cdt,
+    prep: &PreparedPlc,
+    input: &[Point],
+    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
+    domain: &Domain<'_>,
+    carved: &mut Option<Carved>,
+) -> FlatTets {
+    let Some((flat, slab_cache, kept)) = find_flat(cdt, prep, input, seg_ends, domain, carved)
+    else {
         return FlatTets::default();
-    }
+    };
+    let diag = diagonal(input);
     // A free point must leave every facet's slab: all are needed from here on.
     let slabs: Vec<Option<Slab>> = slab_cache
         .into_iter()
         .enumerate()
-        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(fi)))
+        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(prep, input, diag, fi)))
         .collect();
-    let mut out = FlatTets::default();
+    let mut out = FlatTets {
+        found: (flat.len(), flat.first().map(|x| x.1)),
+        ..Default::default()
+    };
     for (t, f) in flat {
         let Some(slab) = slabs[f as usize].as_ref() else {
             continue;
@@ -229,6 +239,45 @@ pub(crate) fn free_points(
         }
     }
     out
+}
+
+/// The sorted vertices of a merged facet's rings.
+fn ring_verts(f: &super::prepare::MergedFacet) -> Vec<u32> {
+    let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
+    verts.sort_unstable();
+    verts.dedup();
+    verts
+}
+
+/// Facet `fi`'s slab (`diag` the input's diagonal), or `None` for a facet without
+/// rings or plane.
+fn slab_of(prep: &PreparedPlc, input: &[Point], diag: f64, fi: usize) -> Option<Slab> {
+    let f = &prep.facets[fi];
+    let verts = ring_verts(f);
+    if verts.is_empty() || f.normal == [0.0; 3] {
+        return None;
+    }
+    let k = verts.len() as f64;
+    let mean: Point =
+        std::array::from_fn(|a| verts.iter().map(|&v| input[v as usize][a]).sum::<f64>() / k);
+    let mut slab = Slab {
+        normal: f.normal,
+        mean,
+        tol: 0.0,
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+    };
+    let mut dev = 0.0f64;
+    for &v in &verts {
+        let p = &input[v as usize];
+        dev = dev.max(slab.height(p).abs());
+        for (a, &x) in p.iter().enumerate() {
+            slab.lo[a] = slab.lo[a].min(x);
+            slab.hi[a] = slab.hi[a].max(x);
+        }
+    }
+    slab.tol = (1e-10 * diag).max(4.0 * dev);
+    Some(slab)
 }
 
 /// Whether the tet is flat by the [`FLAT`] measure.
