@@ -645,27 +645,25 @@ fn attempt(
     }
 
     stats.free_steiner_points = 0;
-    let domain = slivers::Domain {
-        holes: &plc.holes,
-        regions: &plc.regions,
-        keep_hull: opts.keep_hull,
+    let search = |cdt: &Cdt| slivers::Search {
+        prep: merged,
+        input: &plc.points,
+        seg_ends: segment_ends(&subsegs, &cdt.dt.orig),
+        domain: slivers::Domain {
+            holes: &plc.holes,
+            regions: &plc.regions,
+            keep_hull: opts.keep_hull,
+        },
     };
     // The flat tets left on facets, when known (`None` after points went in).
     let mut flat_left: Option<(usize, Option<u32>)> = None;
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
         // Free points go straight into the CDT (`free.rs`), round after round; only if
         // none of a round's can does the construction start again with them.
-        let seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
+        let search = search(&cdt);
         let mut stuck = Vec::new();
         for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(
-                &mut cdt,
-                merged,
-                &plc.points,
-                &seg_ends,
-                &domain,
-                &mut carved,
-            );
+            let found = slivers::free_points(&mut cdt, &search, &mut carved);
             flat_left = Some(found.found);
             let free = found.points;
             stuck = found.stuck;
@@ -725,15 +723,8 @@ fn attempt(
     let flat_left = match flat_left {
         Some(known) => known,
         None => {
-            let seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
-            slivers::flat_left(
-                &mut cdt,
-                merged,
-                &plc.points,
-                &seg_ends,
-                &domain,
-                &mut carved,
-            )
+            let search = search(&cdt);
+            slivers::flat_left(&mut cdt, &search, &mut carved)
         }
     };
     Ok(Attempt::Done(Box::new(Built {

@@ -48,6 +48,16 @@ pub(crate) struct Domain<'a> {
     pub keep_hull: bool,
 }
 
+/// What the search for flat tets on facets needs besides the CDT: the facets as merged
+/// (`prep`), the input points, the input ends of the segment of each Steiner point on
+/// one (which name the facets a flat tet of such points may lie on), and the domain.
+pub(crate) struct Search<'a> {
+    pub prep: &'a PreparedPlc,
+    pub input: &'a [Point],
+    pub seg_ends: FxHashMap<VertexId, [u32; 2]>,
+    pub domain: Domain<'a>,
+}
+
 /// What [`free_points`] found.
 #[derive(Default)]
 pub(crate) struct FlatTets {
@@ -72,14 +82,13 @@ type Found = (
 
 /// Finds the flat tets that carving keeps and that lie on one facet (see [`Found`]);
 /// `None` if there are none. `carved` is the CDT's carving if known, and is set if made.
-fn find_flat(
-    cdt: &mut Cdt,
-    prep: &PreparedPlc,
-    input: &[Point],
-    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
-    domain: &Domain<'_>,
-    carved: &mut Option<Carved>,
-) -> Option<Found> {
+fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) -> Option<Found> {
+    let Search {
+        prep,
+        input,
+        seg_ends,
+        domain,
+    } = search;
     // A tet can lie on one facet only if it has a Steiner point (which may lie in a
     // slab), or if its four input vertices share a facet, which then has four or more:
     // that rules out most tets before any geometry.
@@ -189,13 +198,10 @@ fn find_flat(
 /// what is left once no free point removes any more. `carved` as in [`free_points`].
 pub(crate) fn flat_left(
     cdt: &mut Cdt,
-    prep: &PreparedPlc,
-    input: &[Point],
-    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
-    domain: &Domain<'_>,
+    search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> (usize, Option<u32>) {
-    find_flat(cdt, prep, input, seg_ends, domain, carved).map_or((0, None), |(flat, _, _)| {
+    find_flat(cdt, search, carved).map_or((0, None), |(flat, _, _)| {
         (flat.len(), flat.first().map(|x| x.1))
     })
 }
@@ -205,16 +211,13 @@ pub(crate) fn flat_left(
 /// if made.
 pub(crate) fn free_points(
     cdt: &mut Cdt,
-    prep: &PreparedPlc,
-    input: &[Point],
-    seg_ends: &FxHashMap<VertexId, [u32; 2]>,
-    domain: &Domain<'_>,
+    search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> FlatTets {
-    let Some((flat, slab_cache, kept)) = find_flat(cdt, prep, input, seg_ends, domain, carved)
-    else {
+    let Some((flat, slab_cache, kept)) = find_flat(cdt, search, carved) else {
         return FlatTets::default();
     };
+    let (prep, input) = (search.prep, search.input);
     let diag = diagonal(input);
     // A free point must leave every facet's slab: all are needed from here on.
     let slabs: Vec<Option<Slab>> = slab_cache
