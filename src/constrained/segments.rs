@@ -352,14 +352,15 @@ impl Cavity {
 /// Is `b` a vertex of the tets around edge `a`–`w`, turning once around it from the tet
 /// that `a` points at? Right after `w` was inserted, that tet is one of the new ones
 /// (so it holds `w`), and the tets around the edge are the new tets on `a`'s boundary
-/// faces. False, never wrongly true, when the walk finds anything else.
+/// faces. False, never wrongly true, when the walk finds anything else: `keeps_edge`
+/// then asks the removed tets, which at worst sends a kept piece back to be looked at.
 fn on_rim(dt: &Delaunay, a: VertexId, w: VertexId, b: VertexId) -> bool {
     let Some(start) = dt.mesh.vertex_tet(a) else {
         return false;
     };
     let mut t = start;
     let mut prev = None;
-    // A ring longer than this is left to the walk around the vertex.
+    // A ring longer than this is left to the removed tets' test (see `keeps_edge`).
     for _ in 0..64 {
         let v = dt.mesh.verts(t);
         if !v.contains(&a) || !v.contains(&w) {
