@@ -645,7 +645,10 @@ fn attempt(
     }
 
     stats.free_steiner_points = 0;
-    let search = |cdt: &Cdt| slivers::Search {
+    // What the flat-tet search needs, made once when first needed (free points leave
+    // the subsegments as they are).
+    let mut search: Option<slivers::Search> = None;
+    let make_search = |cdt: &Cdt| slivers::Search {
         prep: merged,
         input: &plc.points,
         seg_ends: segment_ends(&subsegs, &cdt.dt.orig),
@@ -660,10 +663,10 @@ fn attempt(
     if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
         // Free points go straight into the CDT (`free.rs`), round after round; only if
         // none of a round's can does the construction start again with them.
-        let search = search(&cdt);
+        let search = search.get_or_insert_with(|| make_search(&cdt));
         let mut stuck = Vec::new();
         for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(&mut cdt, &search, &mut carved);
+            let found = slivers::free_points(&mut cdt, search, &mut carved);
             flat_left = Some(found.found);
             let free = found.points;
             stuck = found.stuck;
@@ -723,8 +726,8 @@ fn attempt(
     let flat_left = match flat_left {
         Some(known) => known,
         None => {
-            let search = search(&cdt);
-            slivers::flat_left(&mut cdt, &search, &mut carved)
+            let search = search.get_or_insert_with(|| make_search(&cdt));
+            slivers::flat_left(&mut cdt, search, &mut carved)
         }
     };
     Ok(Attempt::Done(Box::new(Built {

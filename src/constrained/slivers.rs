@@ -72,13 +72,17 @@ pub(crate) struct FlatTets {
     pub found: (usize, Option<u32>),
 }
 
-/// The flat tets that carving keeps and that lie on one facet, each with that facet; the
-/// slabs built on the way (per facet, `None` where not yet built); and the kept mask.
-type Found = (
-    Vec<(crate::mesh::TetId, u32)>,
-    Vec<Option<Option<Slab>>>,
-    Vec<bool>,
-);
+/// What [`find_flat`] found, and what it built on the way that placing free points needs.
+struct Found {
+    /// The flat tets that carving keeps and that lie on one facet, each with that facet.
+    flat: Vec<(crate::mesh::TetId, u32)>,
+    /// The facets' slabs (`None` where not built yet).
+    slabs: Vec<Option<Option<Slab>>>,
+    /// Which tet slots carving keeps.
+    kept: Vec<bool>,
+    /// The input's bounding-box diagonal.
+    diag: f64,
+}
 
 /// Finds the flat tets that carving keeps and that lie on one facet (see [`Found`]);
 /// `None` if there are none. `carved` is the CDT's carving if known, and is set if made.
@@ -191,7 +195,12 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
             flat.push((t, f));
         }
     }
-    (!flat.is_empty()).then_some((flat, slab_cache, kept))
+    (!flat.is_empty()).then_some(Found {
+        flat,
+        slabs: slab_cache,
+        kept,
+        diag,
+    })
 }
 
 /// How many flat tets that carving keeps lie on one facet, and the facet of the first:
@@ -201,9 +210,8 @@ pub(crate) fn flat_left(
     search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> (usize, Option<u32>) {
-    find_flat(cdt, search, carved).map_or((0, None), |(flat, _, _)| {
-        (flat.len(), flat.first().map(|x| x.1))
-    })
+    find_flat(cdt, search, carved)
+        .map_or((0, None), |f| (f.flat.len(), f.flat.first().map(|x| x.1)))
 }
 
 /// Free vertices that remove the flat tets lying on one facet, one per such tet, and
@@ -214,16 +222,20 @@ pub(crate) fn free_points(
     search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> FlatTets {
-    let Some((flat, slab_cache, kept)) = find_flat(cdt, search, carved) else {
+    let Some(Found {
+        flat,
+        slabs,
+        kept,
+        diag,
+    }) = find_flat(cdt, search, carved)
+    else {
         return FlatTets::default();
     };
-    let (prep, input) = (search.prep, search.input);
-    let diag = diagonal(input);
     // A free point must leave every facet's slab: all are needed from here on.
-    let slabs: Vec<Option<Slab>> = slab_cache
+    let slabs: Vec<Option<Slab>> = slabs
         .into_iter()
         .enumerate()
-        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(prep, input, diag, fi)))
+        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(search.prep, search.input, diag, fi)))
         .collect();
     let mut out = FlatTets {
         found: (flat.len(), flat.first().map(|x| x.1)),
