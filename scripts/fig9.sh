@@ -12,7 +12,8 @@
 #
 # Inputs come from gen_fig9.py (points in [-1,1]^2 x [-0.1,0.1], the rectangle
 # [-2,2]^2 x {0}); meshes keep the hull (-c) since one rectangle encloses no volume.
-# Times: ours are `facet_secs` from --stats-json (facet recovery), TetGen's its -V line
+# Times: ours are `facet_secs` from --stats-json (facet recovery; like TetGen, without the
+# facets' 2D triangulation, which both report apart), TetGen's its -V line
 # "Facet recovery seconds". Crossing tets: ours (the tets of the initial Delaunay
 # tetrahedralization crossing the rectangle, the same for both of our algorithms).
 # Writes OUTDIR/fig9.csv, then runs scripts/fig9.py for OUTDIR/fig9.png and a summary.

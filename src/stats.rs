@@ -132,6 +132,10 @@ impl Stats {
                 format!("{:.6}", p.segment_secs),
             ),
             (
+                "    surface triangulation seconds",
+                format!("{:.6}", p.surface_secs),
+            ),
+            (
                 "(14) facet recovery seconds",
                 format!("{:.6}", p.facet_secs),
             ),
@@ -152,7 +156,7 @@ impl Stats {
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 18] = [
+            let pairs: [(&str, String); 19] = [
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),
@@ -170,6 +174,7 @@ impl Stats {
                 ("enlarged_tets", p.enlarged_tets.to_string()),
                 ("restarts", p.restarts.to_string()),
                 ("segment_secs", json_f64(p.segment_secs)),
+                ("surface_secs", json_f64(p.surface_secs)),
                 ("facet_secs", json_f64(p.facet_secs)),
                 ("carve_secs", json_f64(p.carve_secs)),
                 (
