@@ -53,6 +53,7 @@ ROWS = [
     ("missing regions", "regions"),
     ("(12) Delaunay seconds", "delaunay_secs"),
     ("(13) segment recovery seconds", "segment_secs"),
+    ("surface mesh seconds", "surface_secs"),
     ("(14) cavity retriangulation seconds", "facet_secs"),
     ("(15) flip algorithm seconds", "flip_facet_secs"),
     ("(16) total CDT seconds (cavity)", "total_secs"),
@@ -242,7 +243,8 @@ def fmt(v):
 
 
 def shares(rec):
-    """Delaunay, segments, facets, other as percentages of the CDT time, or None."""
+    """Delaunay, segments, surface mesh, facets, other as percentages of the CDT time, or
+    None."""
     if rec is None:
         return None
     total = rec.get("total_secs") or 0.0
@@ -250,9 +252,10 @@ def shares(rec):
         return None
     d = rec.get("delaunay_secs", 0.0)
     s = rec.get("segment_secs", 0.0)
+    m = rec.get("surface_secs", 0.0)
     f = rec.get("facet_secs", 0.0)
-    other = max(total - d - s - f, 0.0)
-    return [100.0 * x / total for x in (d, s, f, other)]
+    other = max(total - d - s - m - f, 0.0)
+    return [100.0 * x / total for x in (d, s, m, f, other)]
 
 
 def markdown(results, args):
@@ -290,7 +293,7 @@ def markdown(results, args):
     out.append("")
     runs = [("ours -p (cavity)", "ours"), ("ours -pF (flips)", "ours_flip"),
             ("TetGen -p", "tetgen"), ("TetGen -pL", "tetgen_flip")]
-    tasks = ["Delaunay", "segment recovery", "facet recovery", "other"]
+    tasks = ["Delaunay", "segment recovery", "surface mesh", "facet recovery", "other"]
     out.append("| run | task | " + " | ".join(names) + " |")
     out.append("| :--- | :--- " + "| ---: " * len(names) + "|")
     for label, which in runs:
