@@ -134,17 +134,30 @@ pub(super) fn replace(
     new: &[[VertexId; 4]],
     mut on_face: impl FnMut([VertexId; 3]),
 ) -> Result<Vec<TetId>, MeshError> {
-    let mut outer: Vec<([VertexId; 3], FaceRef)> = Vec::with_capacity(8);
+    // A flip replaces at most four tets by four: fixed arrays, and each face's sorted
+    // vertices packed into one integer, so that matching faces is a comparison each.
+    if old.len() > 4 || new.len() > 4 {
+        return Err(MeshError::Internal(format!(
+            "a flip of {} tets into {}",
+            old.len(),
+            new.len()
+        )));
+    }
+    let pack = |k: [VertexId; 3]| (k[0] as u128) << 64 | (k[1] as u128) << 32 | k[2] as u128;
+    let mut outer = [(0u128, FaceRef(0)); 16];
+    let mut n_outer = 0;
     for &t in old {
         for j in 0..4 {
             let key = face_key(mesh.face_verts(t, j));
             let n = mesh.adj(FaceRef::new(t, j));
             if !old.contains(&n.tet()) {
-                outer.push((key, n));
+                outer[n_outer] = (pack(key), n);
+                n_outer += 1;
             }
             on_face(key);
         }
     }
+    let outer = &outer[..n_outer];
     for &t in old {
         mesh.kill_tet(t);
     }
@@ -155,27 +168,29 @@ pub(super) fn replace(
             .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
         made.push(t);
     }
-    let keys: Vec<[[VertexId; 3]; 4]> = new
-        .iter()
-        .map(|v| std::array::from_fn(|j| face_key(FACE_VERTS[j].map(|x| v[x]))))
-        .collect();
+    let mut keys = [[0u128; 4]; 4];
+    for (k, v) in keys.iter_mut().zip(new) {
+        *k = std::array::from_fn(|j| pack(face_key(FACE_VERTS[j].map(|x| v[x]))));
+    }
+    let keys = &keys[..new.len()];
     for a in 0..made.len() {
         'faces: for j in 0..4 {
-            for b in 0..made.len() {
+            let key = keys[a][j];
+            for (b, kb) in keys.iter().enumerate() {
                 if b == a {
                     continue;
                 }
-                if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == keys[a][j]) {
+                if let Some(jj) = kb.iter().position(|&k| k == key) {
                     if b > a {
                         mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
                     }
                     continue 'faces;
                 }
             }
-            let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == keys[a][j]) else {
+            let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == key) else {
                 return Err(MeshError::Internal(format!(
                     "a flip left face {:?} without a neighbour",
-                    keys[a][j]
+                    FACE_VERTS[j].map(|x| new[a][x])
                 )));
             };
             mesh.glue(FaceRef::new(made[a], j), n);

@@ -14,6 +14,7 @@
 use super::cdt::{face_key, Cdt};
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
+use crate::geom::predicates::orient3d_filtered;
 use crate::geom::{orient3d, Point};
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS as EDGES, FACE_VERTS, GHOST};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -363,17 +364,66 @@ pub(crate) struct Region {
     pub(crate) verts: FxHashSet<VertexId>,
     boundary: FxHashSet<(VertexId, VertexId)>,
     boxes: Vec<[[f64; 3]; 2]>,
-    /// For large regions, each vertex's side of each triangle's plane once computed
-    /// ([`UNKNOWN`] before): neighbouring tets share vertices, and a region of
-    /// thousands of sliver triangles fanned from a far vertex (found by fuzzing), whose
-    /// boxes all overlap, cost a minute of exact orientations without it.
-    sides: std::cell::RefCell<FxHashMap<VertexId, Box<[i8]>>>,
+    /// Each vertex's side of each triangle's plane once computed: neighbouring tets
+    /// share vertices (a vertex is met again through every edge of every tet around
+    /// it), and a region of thousands of sliver triangles fanned from a far vertex
+    /// (found by fuzzing), whose boxes all overlap, cost a minute of exact orientations
+    /// without it.
+    sides: std::cell::RefCell<SideCache>,
+}
+
+/// Sides of triangles' planes per vertex, for one region: a row of one entry per
+/// triangle ([`UNKNOWN`] until computed) for each vertex met, in one buffer, found
+/// through a per-vertex index that is kept from one region to the next and stamped, so
+/// that starting a region costs nothing.
+struct SideCache {
+    /// Per vertex id: the stamp of the region that gave it a row, and the row's start.
+    rows: Vec<(u32, u32)>,
+    stamp: u32,
+    buf: Vec<i8>,
+}
+
+thread_local! {
+    static SIDE_CACHE: std::cell::RefCell<Option<SideCache>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+impl SideCache {
+    /// The thread's cache, emptied for a new region.
+    fn take() -> Self {
+        let mut c = SIDE_CACHE
+            .with(|c| c.borrow_mut().take())
+            .unwrap_or(SideCache {
+                rows: Vec::new(),
+                stamp: 0,
+                buf: Vec::new(),
+            });
+        c.stamp = c.stamp.wrapping_add(1);
+        if c.stamp == 0 {
+            c.rows.iter_mut().for_each(|r| r.0 = 0);
+            c.stamp = 1;
+        }
+        c.buf.clear();
+        c
+    }
+}
+
+impl Drop for Region {
+    fn drop(&mut self) {
+        let cache = std::mem::replace(
+            self.sides.get_mut(),
+            SideCache {
+                rows: Vec::new(),
+                stamp: 0,
+                buf: Vec::new(),
+            },
+        );
+        SIDE_CACHE.with(|c| *c.borrow_mut() = Some(cache));
+    }
 }
 
 /// A side not computed yet.
 const UNKNOWN: i8 = 2;
-/// Regions with at least this many triangles cache their vertices' sides.
-const CACHE_SIDES: usize = 64;
 /// The most side entries cached per region (bytes); past it, sides are recomputed.
 const MAX_SIDES: usize = 1 << 26;
 
@@ -414,59 +464,84 @@ impl Region {
             verts,
             boundary,
             boxes,
-            sides: Default::default(),
+            sides: std::cell::RefCell::new(SideCache::take()),
         }
     }
 
-    /// The sign of `orient3d` of triangle `k` and vertex `v`, cached.
-    fn side(&self, pts: &[Point], k: usize, v: VertexId) -> i8 {
-        let compute = || {
-            let [a, b, c] = self.tris[k].map(|x| &pts[x as usize]);
-            let o = orient3d(a, b, c, &pts[v as usize]);
-            (o > 0.0) as i8 - (o < 0.0) as i8
-        };
-        let mut sides = self.sides.borrow_mut();
-        let full = (sides.len() + 1) * self.tris.len() > MAX_SIDES;
-        let row = match sides.entry(v) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(_) if full => return compute(),
-            std::collections::hash_map::Entry::Vacant(e) => {
-                e.insert(vec![UNKNOWN; self.tris.len()].into_boxed_slice())
-            }
-        };
-        if row[k] == UNKNOWN {
-            row[k] = compute();
+    /// The sign of `orient3d` of triangle `k` and vertex `v`.
+    fn side_of(&self, pts: &[Point], k: usize, v: VertexId) -> i8 {
+        let tri = self.tris[k];
+        // A vertex of the triangle lies on its plane.
+        if tri.contains(&v) {
+            return 0;
         }
-        row[k]
+        let [a, b, c] = tri.map(|y| &pts[y as usize]);
+        let p = &pts[v as usize];
+        let o = orient3d_filtered(a, b, c, p).unwrap_or_else(|| orient3d(a, b, c, p));
+        (o > 0.0) as i8 - (o < 0.0) as i8
     }
 
-    /// Does the open segment `pq` cross the region's interior?
-    fn crossed_by(&self, pts: &[Point], p: VertexId, q: VertexId) -> bool {
+    /// Does the open segment `pq`, whose ends lie strictly on opposite sides of triangle
+    /// `k`'s plane, pass through the triangle (its boundary included)?
+    fn pierces(&self, pts: &[Point], k: usize, p: VertexId, q: VertexId) -> bool {
         let (pp, pq) = (&pts[p as usize], &pts[q as usize]);
-        let cached = self.tris.len() >= CACHE_SIDES;
-        for (k, (t, bx)) in self.tris.iter().zip(&self.boxes).enumerate() {
-            if (0..3).any(|k| pp[k].max(pq[k]) < bx[0][k] || pp[k].min(pq[k]) > bx[1][k]) {
-                continue;
-            }
-            let [a, b, c] = t.map(|v| &pts[v as usize]);
-            let straddles = if cached {
-                self.side(pts, k, p) * self.side(pts, k, q) < 0
+        let [a, b, c] = self.tris[k].map(|v| &pts[v as usize]);
+        let s = [
+            orient3d(pp, pq, a, b),
+            orient3d(pp, pq, b, c),
+            orient3d(pp, pq, c, a),
+        ];
+        !(s.iter().any(|&x| x > 0.0) && s.iter().any(|&x| x < 0.0))
+    }
+
+    /// Does an edge of the tet with vertices `v` cross the region's interior? The
+    /// vertices' sides of the triangles' planes come from the region's cache, computed
+    /// when first needed.
+    fn crossed_by_tet(&self, pts: &[Point], v: [VertexId; 4]) -> bool {
+        let n = self.tris.len();
+        let mut cache = self.sides.borrow_mut();
+        let SideCache { rows, stamp, buf } = &mut *cache;
+        let top = v.iter().max().map_or(0, |&m| m as usize);
+        if top >= rows.len() {
+            rows.resize(top + 1, (0, 0));
+        }
+        // Each vertex's row in the buffer (`None` once the buffer is full: then its
+        // sides are computed each time).
+        let start: [Option<usize>; 4] = v.map(|x| {
+            let row = &mut rows[x as usize];
+            if row.0 == *stamp {
+                Some(row.1 as usize)
+            } else if buf.len() + n <= MAX_SIDES {
+                let start = buf.len();
+                buf.resize(start + n, UNKNOWN);
+                *row = (*stamp, start as u32);
+                Some(start)
             } else {
-                let (o1, o2) = (orient3d(a, b, c, pp), orient3d(a, b, c, pq));
-                (o1 > 0.0 && o2 < 0.0) || (o1 < 0.0 && o2 > 0.0)
-            };
-            if !straddles {
-                continue;
+                None
             }
-            let s = [
-                orient3d(pp, pq, a, b),
-                orient3d(pp, pq, b, c),
-                orient3d(pp, pq, c, a),
-            ];
-            let pos = s.iter().any(|&x| x > 0.0);
-            let neg = s.iter().any(|&x| x < 0.0);
-            if !(pos && neg) {
-                return true;
+        });
+        let mut side = |i: usize, k: usize| match start[i] {
+            Some(s) => {
+                if buf[s + k] == UNKNOWN {
+                    buf[s + k] = self.side_of(pts, k, v[i]);
+                }
+                buf[s + k]
+            }
+            None => self.side_of(pts, k, v[i]),
+        };
+        let q = v.map(|x| &pts[x as usize]);
+        for &(i, j) in &EDGES {
+            let (p, r) = (q[i], q[j]);
+            for (k, bx) in self.boxes.iter().enumerate() {
+                // Both ends beyond one side of the triangle's box (coordinates are finite).
+                if (0..3).any(|a| {
+                    (p[a] < bx[0][a] && r[a] < bx[0][a]) || (p[a] > bx[1][a] && r[a] > bx[1][a])
+                }) {
+                    continue;
+                }
+                if side(i, k) * side(j, k) < 0 && self.pierces(pts, k, v[i], v[j]) {
+                    return true;
+                }
             }
         }
         false
@@ -481,9 +556,7 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     }
     let tests = &cdt.crossing_tests;
     tests.set(tests.get() + region.tris.len() as u64);
-    EDGES
-        .iter()
-        .any(|&(i, j)| region.crossed_by(&cdt.dt.points, v[i], v[j]))
+    region.crossed_by_tet(&cdt.dt.points, v)
 }
 
 /// A set of tets (or of other dense ids, such as vertices) as a stamp per slot, in
@@ -1115,14 +1188,19 @@ mod tests {
     use crate::delaunay::Delaunay;
     use crate::geom::lcg;
 
-    /// A region large enough to cache its vertices' sides (a fan of slivers from a far
-    /// vertex, as fuzzing made) answers every segment as the plain exact test does,
-    /// asked in any order and again.
+    /// Regions that cache their vertices' sides (fans of slivers from a far vertex, as
+    /// fuzzing made, small and large, one after the other on one cache) answer every
+    /// tet as the plain exact test of its edges does, asked in any order and again.
     #[test]
     fn cached_sides_answer_as_the_plain_test() {
+        for ring in [4, 128] {
+            sides_match_the_plain_test(ring);
+        }
+    }
+
+    fn sides_match_the_plain_test(ring: usize) {
         let mut s = 5u64;
         let mut pts: Vec<Point> = vec![[1e12, 0.3, 0.1]];
-        let ring = 2 * CACHE_SIDES;
         for k in 0..ring {
             let a = k as f64 / ring as f64 * std::f64::consts::TAU;
             pts.push([a.cos(), a.sin(), 1e-3 * (lcg(&mut s) - 0.5)]);
@@ -1137,7 +1215,6 @@ mod tests {
             .map(|k| [inv[0], inv[1 + k], inv[1 + (k + 1) % ring]])
             .collect();
         let region = Region::new(&cdt, &tris);
-        assert!(region.tris.len() >= CACHE_SIDES);
         let plain = |p: VertexId, q: VertexId| {
             let pt = |v: VertexId| &cdt.dt.points[v as usize];
             tris.iter().any(|t| {
@@ -1157,15 +1234,15 @@ mod tests {
         let n = pts.len() as f64;
         let mut crossing = 0;
         for _ in 0..2000 {
-            let p = (lcg(&mut s) * n) as VertexId % pts.len() as VertexId;
-            let q = (lcg(&mut s) * n) as VertexId % pts.len() as VertexId;
-            if p == q {
+            let v: [VertexId; 4] =
+                std::array::from_fn(|_| (lcg(&mut s) * n) as VertexId % pts.len() as VertexId);
+            if (0..4).any(|i| (i + 1..4).any(|j| v[i] == v[j])) {
                 continue;
             }
-            let want = plain(p, q);
+            let want = EDGES.iter().any(|&(i, j)| plain(v[i], v[j]));
             crossing += want as usize;
-            assert_eq!(region.crossed_by(&cdt.dt.points, p, q), want, "{p} {q}");
+            assert_eq!(region.crossed_by_tet(&cdt.dt.points, v), want, "{v:?}");
         }
-        assert!(crossing > 100, "{crossing}");
+        assert!(crossing > 10 * ring.min(10), "{crossing}");
     }
 }

@@ -60,6 +60,19 @@ fn c(p: &Point) -> Coord3D<f64> {
 /// The sign is always exact; the magnitude is only approximate.
 #[inline]
 pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
+    if let Some(det) = orient3d_filtered(a, b, c_, d) {
+        return det;
+    }
+    if let Some(det) = super::fixed::orient3d(a, b, c_, d) {
+        return -det;
+    }
+    -robust::orient3d(c(a), c(b), c(c_), c(d))
+}
+
+/// [`orient3d`]'s sign when its floating-point filter settles it (`None` where only
+/// exact arithmetic can): for callers that cache the rare exact answers.
+#[inline]
+pub fn orient3d_filtered(a: &Point, b: &Point, c_: &Point, d: &Point) -> Option<f64> {
     let (adx, ady, adz) = (a[0] - d[0], a[1] - d[1], a[2] - d[2]);
     let (bdx, bdy, bdz) = (b[0] - d[0], b[1] - d[1], b[2] - d[2]);
     let (cdx, cdy, cdz) = (c_[0] - d[0], c_[1] - d[1], c_[2] - d[2]);
@@ -72,13 +85,7 @@ pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
     let my = max3(ady.abs(), bdy.abs(), cdy.abs());
     let mz = max3(adz.abs(), bdz.abs(), cdz.abs());
     let bound = O3D_FILTER * (mx * my * mz);
-    if bound > FILTER_MIN && bound < FILTER_MAX && (det > bound || -det > bound) {
-        return -det;
-    }
-    if let Some(det) = super::fixed::orient3d(a, b, c_, d) {
-        return -det;
-    }
-    -robust::orient3d(c(a), c(b), c(c_), c(d))
+    (bound > FILTER_MIN && bound < FILTER_MAX && (det > bound || -det > bound)).then_some(-det)
 }
 
 /// Maximum without `f64::max`'s NaN handling (a NaN here makes the filter fail safe:
