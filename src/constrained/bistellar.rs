@@ -172,28 +172,36 @@ pub(super) fn replace(
     for (k, v) in keys.iter_mut().zip(new) {
         *k = std::array::from_fn(|j| pack(face_key(FACE_VERTS[j].map(|x| v[x]))));
     }
-    let keys = &keys[..new.len()];
-    for a in 0..made.len() {
-        'faces: for j in 0..4 {
+    let m = new.len();
+    // Faces already glued, as a bit per face of each new tet.
+    let mut done = [0u8; 4];
+    for a in 0..m {
+        for j in 0..4 {
+            if done[a] & (1 << j) != 0 {
+                continue;
+            }
             let key = keys[a][j];
-            for (b, kb) in keys.iter().enumerate() {
-                if b == a {
-                    continue;
-                }
-                if let Some(jj) = kb.iter().position(|&k| k == key) {
-                    if b > a {
-                        mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
-                    }
-                    continue 'faces;
+            if let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == key) {
+                mesh.glue(FaceRef::new(made[a], j), n);
+                continue;
+            }
+            // Not on the outside: shared with a later new tet (an earlier one would have
+            // glued it already).
+            let mut glued = false;
+            for b in a + 1..m {
+                if let Some(jj) = (0..4).find(|&jj| keys[b][jj] == key) {
+                    mesh.glue(FaceRef::new(made[a], j), FaceRef::new(made[b], jj));
+                    done[b] |= 1 << jj;
+                    glued = true;
+                    break;
                 }
             }
-            let Some(&(_, n)) = outer.iter().find(|(k, _)| *k == key) else {
+            if !glued {
                 return Err(MeshError::Internal(format!(
                     "a flip left face {:?} without a neighbour",
                     FACE_VERTS[j].map(|x| new[a][x])
                 )));
-            };
-            mesh.glue(FaceRef::new(made[a], j), n);
+            }
         }
     }
     for &t in &made {

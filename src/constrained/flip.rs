@@ -132,6 +132,9 @@ struct Entry {
     e: u32,
 }
 
+/// The most flip times [`Flipper::times`] keeps.
+const KEPT_TIMES: usize = 16;
+
 /// The flag of [`Entry::e`] for events that come first.
 const FORCED: u32 = 1 << 31;
 
@@ -431,6 +434,14 @@ struct Flipper<'a> {
     current: Option<u32>,
     counts: FlipCounts,
     cmp: CompareCounts,
+    /// Flip times of queued events computed again for the orderings the intervals
+    /// leave open, by their sorted five vertices, kept with the exact values they
+    /// computed: in degenerate inputs the same few tied events are compared again and
+    /// again.
+    times: Vec<([VertexId; 5], FlipTime)>,
+    /// The signs of [`cross_sign`] of pairs of queued events that the intervals left
+    /// open, by their sorted five vertices.
+    orders: Vec<([VertexId; 5], [VertexId; 5], i32)>,
     /// Subfaces among the faces of deleted tets.
     at_risk: Vec<[VertexId; 3]>,
     /// Crossing tets (a left and a right vertex) left when the queue ran dry.
@@ -472,6 +483,8 @@ impl<'a> Flipper<'a> {
             current: None,
             counts: FlipCounts::default(),
             cmp: CompareCounts::default(),
+            times: Vec::new(),
+            orders: Vec::new(),
             at_risk: Vec::new(),
             crossing_left: 0,
         }
@@ -628,7 +641,7 @@ impl<'a> Flipper<'a> {
                 }
                 let verts = self.certificate_verts(f);
                 let time = self.time_from(verts);
-                let now = self.time_of(cur);
+                let now = self.time_from(self.events[cur as usize].verts);
                 if cross_sign(&now, &time, &self.lift, &mut self.cmp) > 0 {
                     self.counts.not_regular += 1;
                     self.push_event(f, verts, time, true);
@@ -684,11 +697,20 @@ impl<'a> Flipper<'a> {
     /// What the flip certificate of five vertices in certificate order needs: their
     /// points, perturbation indices, which are left, and their heights.
     fn certificate_of(&self, ids: [VertexId; 5]) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
-        let pts = ids.map(|x| self.cdt.dt.points[x as usize]);
-        let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
+        // One plain loop: five `array::map`s cost several times more here, where every
+        // flip certifies about five faces.
         let zero = Approx { v: 0.0, p: 0.0 };
-        let sh = ids.map(|x| self.marks.side(x).unwrap_or((0, zero)));
-        (pts, orig, sh.map(|x| x.0 == 1), sh.map(|x| x.1))
+        let (mut pts, mut orig, mut left, mut heights) =
+            ([[0.0; 3]; 5], [0; 5], [false; 5], [zero; 5]);
+        for (k, &x) in ids.iter().enumerate() {
+            pts[k] = self.cdt.dt.points[x as usize];
+            orig[k] = self.cdt.dt.orig[x as usize];
+            if let Some((side, h)) = self.marks.side(x) {
+                left[k] = side == 1;
+                heights[k] = h;
+            }
+        }
+        (pts, orig, left, heights)
     }
 
     /// The flip certificate of five vertices in certificate order.
@@ -697,9 +719,15 @@ impl<'a> Flipper<'a> {
         FlipTime::new(pts, orig, left, heights)
     }
 
-    /// The flip time of event `e`, computed again from its five vertices.
-    fn time_of(&self, e: u32) -> FlipTime {
-        self.time_from(self.events[e as usize].verts)
+    /// The flip time of an event with J > 0 whose five vertices, sorted, are `five`
+    /// (`verts` in certificate order), as an index into [`Flipper::times`].
+    fn kept_time(&mut self, five: [VertexId; 5], verts: [VertexId; 5]) -> usize {
+        if let Some(i) = self.times.iter().position(|(v, _)| *v == five) {
+            return i;
+        }
+        let t = self.time_from(verts);
+        self.times.push((five, t));
+        self.times.len() - 1
     }
 
     /// Queues the flip of crossing face `f` if it ever happens.
@@ -809,8 +837,47 @@ impl<'a> Flipper<'a> {
             self.cmp.filtered += 1;
             return a < b;
         }
-        let (ta, tb) = (self.time_of(a), self.time_of(b));
-        match cross_sign(&ta, &tb, &self.lift, &mut self.cmp) {
+        let (va, vb) = (self.events[a as usize].verts, self.events[b as usize].verts);
+        let (fa, fb) = (
+            self.events[a as usize].five(),
+            self.events[b as usize].five(),
+        );
+        // Queued events have J > 0, so that the order of a certificate's rows cannot
+        // change the sign of I or J: events of one five points (the faces of one coming
+        // flip) share one flip time, and two events' order is one of their fives'. Orders
+        // of tied events, which only the perturbation settles, are asked again and again
+        // as the heap moves them, so both are kept.
+        let known = self.orders.iter().find_map(|&(x, y, s)| {
+            if (x, y) == (fa, fb) {
+                Some(s)
+            } else if (x, y) == (fb, fa) {
+                Some(-s)
+            } else {
+                None
+            }
+        });
+        let sign = match known {
+            Some(s) => s,
+            None => {
+                // A few entries suffice; a linear search must stay cheap.
+                if self.times.len() + 2 > KEPT_TIMES {
+                    self.times.clear();
+                }
+                if self.orders.len() >= KEPT_TIMES {
+                    self.orders.clear();
+                }
+                let (ia, ib) = (self.kept_time(fa, va), self.kept_time(fb, vb));
+                let s = cross_sign(
+                    &self.times[ia].1,
+                    &self.times[ib].1,
+                    &self.lift,
+                    &mut self.cmp,
+                );
+                self.orders.push((fa, fb, s));
+                s
+            }
+        };
+        match sign {
             0 => a < b,
             s => s < 0,
         }
