@@ -21,18 +21,45 @@ pub(super) enum Kind {
     T44,
 }
 
+/// At most four items, in place: a flip's lists are that short, and allocating them
+/// cost a tenth of a flip.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Few<T: Copy + Default> {
+    items: [T; 4],
+    len: u8,
+}
+
+impl<T: Copy + Default> Few<T> {
+    /// The items of `list` (at most four).
+    fn of(list: &[T]) -> Self {
+        let mut items = [T::default(); 4];
+        items[..list.len()].copy_from_slice(list);
+        Few {
+            items,
+            len: list.len() as u8,
+        }
+    }
+}
+
+impl<T: Copy + Default> std::ops::Deref for Few<T> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        &self.items[..self.len as usize]
+    }
+}
+
 /// What flipping a face would do.
 pub(super) struct Shape {
     /// The kind of flip.
     pub kind: Kind,
     /// The tets it removes.
-    pub old: Vec<TetId>,
+    pub old: Few<TetId>,
     /// The positively oriented tets that replace them, filling the same volume.
-    pub new: Vec<[VertexId; 4]>,
+    pub new: Few<[VertexId; 4]>,
     /// The face flipped away (2-3), or the edge removed (3-2, 4-4) with the vertices
     /// around it: the faces `(edge, apex)` go with it.
     pub face: [VertexId; 3],
-    pub edge: Option<([VertexId; 2], Vec<VertexId>)>,
+    pub edge: Option<([VertexId; 2], Few<VertexId>)>,
 }
 
 /// The flip that removes face `f` (between two real tets), if the tets around it allow
@@ -61,21 +88,21 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
         orient3d(p[0], p[1], p[2], p[3])
     };
     let o: [f64; 3] = std::array::from_fn(|k| orient(&rep(k)));
-    let neg: Vec<usize> = (0..3).filter(|&k| o[k] < 0.0).collect();
-    let zero: Vec<usize> = (0..3).filter(|&k| o[k] == 0.0).collect();
+    let negs = o.iter().filter(|&&x| x < 0.0).count();
+    let zeros = o.iter().filter(|&&x| x == 0.0).count();
     // The face of `t` opposite vertex `x`.
     let opposite = |t: TetId, x: VertexId| mesh.verts(t).iter().position(|&y| y == x);
-    if neg.is_empty() && zero.is_empty() {
+    if negs == 0 && zeros == 0 {
         return Some(Shape {
             kind: Kind::T23,
-            old: vec![t1, t2],
-            new: vec![rep(0), rep(1), rep(2)],
+            old: Few::of(&[t1, t2]),
+            new: Few::of(&[rep(0), rep(1), rep(2)]),
             face: s,
             edge: None,
         });
     }
-    if neg.len() == 1 && zero.is_empty() {
-        let k = neg[0];
+    if negs == 1 && zeros == 0 {
+        let k = (0..3).find(|&k| o[k] < 0.0)?;
         let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
         let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
         if mesh.is_ghost(t3) || !mesh.verts(t3).contains(&w) {
@@ -83,14 +110,14 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
         }
         return Some(Shape {
             kind: Kind::T32,
-            old: vec![t1, t2, t3],
-            new: vec![rep((k + 1) % 3), rep((k + 2) % 3)],
+            old: Few::of(&[t1, t2, t3]),
+            new: Few::of(&[rep((k + 1) % 3), rep((k + 2) % 3)]),
             face: s,
-            edge: Some(([e0, e1], vec![s[k], v, w])),
+            edge: Some(([e0, e1], Few::of(&[s[k], v, w]))),
         });
     }
-    if zero.len() == 1 && neg.is_empty() {
-        let k = zero[0];
+    if zeros == 1 && negs == 0 {
+        let k = (0..3).find(|&k| o[k] == 0.0)?;
         let (e0, e1) = (s[(k + 1) % 3], s[(k + 2) % 3]);
         let t3 = mesh.adj(FaceRef::new(t1, opposite(t1, s[k])?)).tet();
         let t4 = mesh.adj(FaceRef::new(t2, opposite(t2, s[k])?)).tet();
@@ -103,23 +130,21 @@ pub(super) fn shape(mesh: &Mesh, pts: &[Point], f: FaceRef) -> Option<Shape> {
             return None;
         }
         // On u's side: t3 with e0 (then e1) replaced by w.
-        let mut new = vec![rep((k + 1) % 3), rep((k + 2) % 3)];
-        for e in [e0, e1] {
-            let mut t = t3v;
+        let mut on_u = [t3v; 2];
+        for (t, e) in on_u.iter_mut().zip([e0, e1]) {
             if let Some(p) = t.iter().position(|&x| x == e) {
                 t[p] = w;
             }
-            if orient(&t) <= 0.0 {
+            if orient(t) <= 0.0 {
                 return None;
             }
-            new.push(t);
         }
         return Some(Shape {
             kind: Kind::T44,
-            old: vec![t1, t2, t3, t4],
-            new,
+            old: Few::of(&[t1, t2, t3, t4]),
+            new: Few::of(&[rep((k + 1) % 3), rep((k + 2) % 3), on_u[0], on_u[1]]),
             face: s,
-            edge: Some(([e0, e1], vec![s[k], v, w, u])),
+            edge: Some(([e0, e1], Few::of(&[s[k], v, w, u]))),
         });
     }
     None
@@ -133,7 +158,7 @@ pub(super) fn replace(
     old: &[TetId],
     new: &[[VertexId; 4]],
     mut on_face: impl FnMut([VertexId; 3]),
-) -> Result<Vec<TetId>, MeshError> {
+) -> Result<Few<TetId>, MeshError> {
     // A flip replaces at most four tets by four: fixed arrays, and each face's sorted
     // vertices packed into one integer, so that matching faces is a comparison each.
     if old.len() > 4 || new.len() > 4 {
@@ -161,12 +186,13 @@ pub(super) fn replace(
     for &t in old {
         mesh.kill_tet(t);
     }
-    let mut made = Vec::with_capacity(new.len());
+    let mut made = Few::of(&[]);
     for &v in new {
         let t = mesh
             .add_tet(v)
             .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
-        made.push(t);
+        made.items[made.len as usize] = t;
+        made.len += 1;
     }
     let mut keys = [[0u128; 4]; 4];
     for (k, v) in keys.iter_mut().zip(new) {
@@ -204,7 +230,7 @@ pub(super) fn replace(
             }
         }
     }
-    for &t in &made {
+    for &t in made.iter() {
         for x in mesh.verts(t) {
             if x != GHOST {
                 mesh.set_vertex_tet(x, t);

@@ -19,7 +19,7 @@
 //! and otherwise the region asks for a Steiner point on the polygon, like the cavity
 //! algorithm does.
 
-use super::bistellar::{self, Kind};
+use super::bistellar::{self, Few, Kind};
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats, SlotSet};
 use super::cdt::{edge_key, face_key, Cdt};
 use crate::error::MeshError;
@@ -909,7 +909,7 @@ impl<'a> Flipper<'a> {
         &mut self,
         f: FaceRef,
         repair: bool,
-    ) -> Result<Result<Vec<TetId>, Refusal>, MeshError> {
+    ) -> Result<Result<Few<TetId>, Refusal>, MeshError> {
         let Some(sh) = bistellar::shape(&self.cdt.dt.mesh, &self.cdt.dt.points, f) else {
             return Ok(Err(Refusal::NotFlippable));
         };
@@ -947,7 +947,7 @@ impl<'a> Flipper<'a> {
 
     /// Replaces tets `old` by the positively oriented tets `new` (which fill the same
     /// volume), keeping R's membership and noting the subfaces at risk.
-    fn replace(&mut self, old: &[TetId], new: &[[VertexId; 4]]) -> Result<Vec<TetId>, MeshError> {
+    fn replace(&mut self, old: &[TetId], new: &[[VertexId; 4]]) -> Result<Few<TetId>, MeshError> {
         let subfaces = &self.cdt.subfaces;
         let at_risk = &mut self.at_risk;
         let made = bistellar::replace(&mut self.cdt.dt.mesh, old, new, |key| {
@@ -959,7 +959,7 @@ impl<'a> Flipper<'a> {
             self.in_r.remove(t);
             self.gens.renew(t);
         }
-        for &t in &made {
+        for &t in made.iter() {
             self.gens.renew(t);
             self.in_r.insert(t);
             self.r_list.push(t);
@@ -991,7 +991,7 @@ impl<'a> Flipper<'a> {
             budget -= 1;
             match self.try_flip(f, true)? {
                 Ok(new) => {
-                    for t in new {
+                    for &t in new.iter() {
                         for i in 0..4 {
                             work.push(FaceRef::new(t, i));
                         }

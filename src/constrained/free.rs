@@ -171,7 +171,10 @@ fn flip_to_delaunay(cdt: &mut Cdt, changes: &mut Vec<Change>) -> Result<bool, Me
                 .flat_map(|&t| (0..4).map(move |i| FaceRef::new(t, i))),
         );
         queue.append(&mut stuck);
-        changes.push(Change { old, new: made });
+        changes.push(Change {
+            old,
+            new: made.to_vec(),
+        });
     }
     Ok(stuck.iter().all(|&f| !not_delaunay(cdt, f)))
 }
