@@ -22,7 +22,7 @@ pub(super) enum Kind {
 }
 
 /// At most four items, in place: a flip's lists are that short, and allocating them
-/// cost a tenth of a flip.
+/// cost a few percent of every flip.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Few<T: Copy + Default> {
     items: [T; 4],
@@ -38,6 +38,12 @@ impl<T: Copy + Default> Few<T> {
             items,
             len: list.len() as u8,
         }
+    }
+
+    /// Appends `x` (there must be room).
+    fn push(&mut self, x: T) {
+        self.items[self.len as usize] = x;
+        self.len += 1;
     }
 }
 
@@ -191,8 +197,7 @@ pub(super) fn replace(
         let t = mesh
             .add_tet(v)
             .map_err(|_| MeshError::Unsupported("the mesh exceeds 2^30 tets".into()))?;
-        made.items[made.len as usize] = t;
-        made.len += 1;
+        made.push(t);
     }
     let mut keys = [[0u128; 4]; 4];
     for (k, v) in keys.iter_mut().zip(new) {

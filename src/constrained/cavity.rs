@@ -14,7 +14,6 @@
 use super::cdt::{face_key, Cdt};
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
-use crate::geom::predicates::orient3d_filtered;
 use crate::geom::{orient3d, Point};
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS as EDGES, FACE_VERTS, GHOST};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -389,15 +388,17 @@ thread_local! {
 }
 
 impl SideCache {
+    const EMPTY: SideCache = SideCache {
+        rows: Vec::new(),
+        stamp: 0,
+        buf: Vec::new(),
+    };
+
     /// The thread's cache, emptied for a new region.
     fn take() -> Self {
         let mut c = SIDE_CACHE
             .with(|c| c.borrow_mut().take())
-            .unwrap_or(SideCache {
-                rows: Vec::new(),
-                stamp: 0,
-                buf: Vec::new(),
-            });
+            .unwrap_or(SideCache::EMPTY);
         c.stamp = c.stamp.wrapping_add(1);
         if c.stamp == 0 {
             c.rows.iter_mut().for_each(|r| r.0 = 0);
@@ -410,14 +411,7 @@ impl SideCache {
 
 impl Drop for Region {
     fn drop(&mut self) {
-        let cache = std::mem::replace(
-            self.sides.get_mut(),
-            SideCache {
-                rows: Vec::new(),
-                stamp: 0,
-                buf: Vec::new(),
-            },
-        );
+        let cache = std::mem::replace(self.sides.get_mut(), SideCache::EMPTY);
         SIDE_CACHE.with(|c| *c.borrow_mut() = Some(cache));
     }
 }
@@ -476,8 +470,7 @@ impl Region {
             return 0;
         }
         let [a, b, c] = tri.map(|y| &pts[y as usize]);
-        let p = &pts[v as usize];
-        let o = orient3d_filtered(a, b, c, p).unwrap_or_else(|| orient3d(a, b, c, p));
+        let o = orient3d(a, b, c, &pts[v as usize]);
         (o > 0.0) as i8 - (o < 0.0) as i8
     }
 

@@ -132,7 +132,7 @@ struct Entry {
     e: u32,
 }
 
-/// The most flip times [`Flipper::times`] keeps.
+/// The most entries [`Flipper::times`] and [`Flipper::orders`] keep.
 const KEPT_TIMES: usize = 16;
 
 /// The flag of [`Entry::e`] for events that come first.

@@ -70,9 +70,9 @@ pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
 }
 
 /// [`orient3d`]'s sign when its floating-point filter settles it (`None` where only
-/// exact arithmetic can): for callers that cache the rare exact answers.
+/// exact arithmetic can).
 #[inline]
-pub fn orient3d_filtered(a: &Point, b: &Point, c_: &Point, d: &Point) -> Option<f64> {
+fn orient3d_filtered(a: &Point, b: &Point, c_: &Point, d: &Point) -> Option<f64> {
     let (adx, ady, adz) = (a[0] - d[0], a[1] - d[1], a[2] - d[2]);
     let (bdx, bdy, bdz) = (b[0] - d[0], b[1] - d[1], b[2] - d[2]);
     let (cdx, cdy, cdz) = (c_[0] - d[0], c_[1] - d[1], c_[2] - d[2]);
