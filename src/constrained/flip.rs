@@ -1032,16 +1032,18 @@ impl<'a> Flipper<'a> {
         if mesh.is_ghost(g.tet()) {
             return false;
         }
-        let s = mesh.face_verts(t, f.face());
-        if self.region_faces.contains(&face_key(s)) || self.cdt.is_subface(t, f.face()) {
-            return false;
-        }
         let tv = mesh.verts(t);
         let w = mesh.verts(g.tet())[g.face()];
         let ids = [tv[0], tv[1], tv[2], tv[3], w];
         let p = ids.map(|x| &self.cdt.dt.points[x as usize]);
         let orig = ids.map(|x| self.cdt.dt.orig[x as usize]);
-        insphere_sos(p, orig) == Sign::Positive
+        // Nearly every face is locally Delaunay: the constraints, two hash lookups, are
+        // looked up only for the few that are not.
+        if insphere_sos(p, orig) != Sign::Positive {
+            return false;
+        }
+        let s = mesh.face_verts(t, f.face());
+        !(self.region_faces.contains(&face_key(s)) || self.cdt.is_subface(t, f.face()))
     }
 }
 
