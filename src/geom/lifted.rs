@@ -692,6 +692,57 @@ mod tests {
         assert!(decided_by_intervals() > 1000);
     }
 
+    /// A flip time with J > 0 does not depend on the order of its five points: the
+    /// flips keep one flip time, and one order against another event, per sorted five
+    /// vertices on that ground. Checked against every other event, ties included.
+    #[test]
+    fn flip_times_with_positive_j_do_not_depend_on_the_order_of_the_five() {
+        let lift = Lifting {
+            abc: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        };
+        let mut s = 17u64;
+        let mut events: Vec<([Point; 5], [u32; 5])> = Vec::new();
+        let mut next_id = 0u32;
+        while events.len() < 40 {
+            let p: [Point; 5] =
+                std::array::from_fn(|_| std::array::from_fn(|_| (lcg(&mut s) * 7.0).floor() - 3.0));
+            let ids = std::array::from_fn(|k| next_id + k as u32);
+            next_id += 5;
+            if cert(&lift, p, ids).flips(&lift) {
+                events.push((p, ids));
+            }
+        }
+        let mut counts = CompareCounts::default();
+        let mut reordered = 0;
+        for (p, ids) in &events {
+            let a = cert(&lift, *p, *ids);
+            for _ in 0..6 {
+                // A random order of the five points (odd ones make J negative: skipped).
+                let mut order = [0usize, 1, 2, 3, 4];
+                for k in (1..5).rev() {
+                    order.swap(k, (lcg(&mut s) * (k + 1) as f64) as usize);
+                }
+                let a2 = cert(&lift, order.map(|k| p[k]), order.map(|k| ids[k]));
+                if !a2.flips(&lift) {
+                    continue;
+                }
+                reordered += 1;
+                assert_eq!(cross_sign(&a, &a2, &lift, &mut counts), 0);
+                for (q, qids) in &events {
+                    let b = cert(&lift, *q, *qids);
+                    assert_eq!(
+                        cross_sign(&a, &b, &lift, &mut counts),
+                        cross_sign(&a2, &b, &lift, &mut counts)
+                    );
+                }
+            }
+        }
+        assert!(
+            reordered > 40 && counts.perturbed > 0,
+            "{reordered} {counts:?}"
+        );
+    }
+
     thread_local! {
         static DECIDED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
     }
