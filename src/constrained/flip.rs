@@ -843,15 +843,15 @@ impl<'a> Flipper<'a> {
     fn earlier_close(&mut self, a: u32, b: u32) -> bool {
         // Nearly all are faces of one coming flip (the three around an edge of a 3-2
         // flip): the same five points, the same event.
-        if self.events[a as usize].five() == self.events[b as usize].five() {
-            self.cmp.filtered += 1;
-            return a < b;
-        }
-        let (va, vb) = (self.events[a as usize].verts, self.events[b as usize].verts);
         let (fa, fb) = (
             self.events[a as usize].five(),
             self.events[b as usize].five(),
         );
+        if fa == fb {
+            self.cmp.filtered += 1;
+            return a < b;
+        }
+        let (va, vb) = (self.events[a as usize].verts, self.events[b as usize].verts);
         // Queued events have J > 0, so that the order of a certificate's rows cannot
         // change the sign of I or J: events of one five points (the faces of one coming
         // flip) share one flip time, and two events' order is one of their fives'. Orders
