@@ -121,6 +121,8 @@ pub fn insert_region(
         }
     };
     let mut sides: [Option<SideDt>; 2] = [None, None];
+    // Both sides' inner vertices, found again only after the cavity grows.
+    let mut inner_verts: Option<[Vec<VertexId>; 2]> = None;
     #[allow(clippy::needless_range_loop)] // `side` also selects the face list and lid
     for side in 0..2 {
         loop {
@@ -130,7 +132,8 @@ pub fn insert_region(
                 (&bottom, true)
             };
             let all = side_faces(faces, &region, lid_flip);
-            let inner = inner_vertices(cdt, &cavity, &top, &bottom, &region);
+            let inner = inner_verts
+                .get_or_insert_with(|| inner_vertices(cdt, &cavity, &top, &bottom, &region));
             let sdt = delaunay_of(cdt, &all, &inner[side])?;
             let missing = sdt.missing(&all);
             if missing.is_empty() {
@@ -168,6 +171,7 @@ pub fn insert_region(
                 }
                 cavity.push(outside);
                 enlarged += 1;
+                inner_verts = None;
             }
         }
     }
