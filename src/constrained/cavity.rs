@@ -502,29 +502,33 @@ impl Region {
         if top >= rows.len() {
             rows.resize(top + 1, (0, 0));
         }
-        // Each vertex's row in the buffer (`None` once the buffer is full: then its
-        // sides are computed each time).
-        let start: [Option<usize>; 4] = v.map(|x| {
-            let row = &mut rows[x as usize];
-            if row.0 == *stamp {
-                Some(row.1 as usize)
-            } else if buf.len() + n <= MAX_SIDES {
-                let start = buf.len();
-                buf.resize(start + n, UNKNOWN);
-                *row = (*stamp, start as u32);
-                Some(start)
-            } else {
-                None
-            }
-        });
-        let mut side = |i: usize, k: usize| match start[i] {
-            Some(s) => {
-                if buf[s + k] == UNKNOWN {
-                    buf[s + k] = self.side_of(pts, k, v[i]);
+        // Each vertex's row in the buffer, found (or made) when first needed: a tet whose
+        // box misses every triangle's needs none. `None` once the buffer is full: then
+        // the vertex's sides are computed each time.
+        let mut start: [Option<Option<usize>>; 4] = [None; 4];
+        let mut side = |i: usize, k: usize| {
+            let s = *start[i].get_or_insert_with(|| {
+                let row = &mut rows[v[i] as usize];
+                if row.0 == *stamp {
+                    Some(row.1 as usize)
+                } else if buf.len() + n <= MAX_SIDES {
+                    let s = buf.len();
+                    buf.resize(s + n, UNKNOWN);
+                    *row = (*stamp, s as u32);
+                    Some(s)
+                } else {
+                    None
                 }
-                buf[s + k]
+            });
+            match s {
+                Some(s) => {
+                    if buf[s + k] == UNKNOWN {
+                        buf[s + k] = self.side_of(pts, k, v[i]);
+                    }
+                    buf[s + k]
+                }
+                None => self.side_of(pts, k, v[i]),
             }
-            None => self.side_of(pts, k, v[i]),
         };
         let q = v.map(|x| &pts[x as usize]);
         for &(i, j) in &EDGES {

@@ -493,8 +493,7 @@ impl<'a> Flipper<'a> {
     /// Flips until no crossing triangle is left; true if the region's triangles are then
     /// all mesh faces.
     fn run(&mut self) -> Result<bool, MeshError> {
-        let mut r = self.tets_of_r();
-        r.sort_unstable();
+        let r = self.tets_of_r();
         for &t in &r {
             for i in 0..4 {
                 let f = FaceRef::new(t, i);
@@ -657,7 +656,7 @@ impl<'a> Flipper<'a> {
         self.in_r.contains(&t)
     }
 
-    /// The tets of R now, without repeats.
+    /// The tets of R now, without repeats, in increasing order.
     fn tets_of_r(&mut self) -> Vec<TetId> {
         let slots = self.cdt.dt.mesh.num_slots();
         // In increasing order. Where R is a large part of the mesh (as in Figure 9), a
@@ -971,8 +970,7 @@ impl<'a> Flipper<'a> {
     /// where a flip keeping the region can, and reports a shim or a face that remains.
     fn repair(&mut self) -> Result<Option<Problem>, MeshError> {
         let mut work: Vec<FaceRef> = Vec::new();
-        let mut r = self.tets_of_r();
-        r.sort_unstable();
+        let r = self.tets_of_r();
         for &t in &r {
             for i in 0..4 {
                 work.push(FaceRef::new(t, i));
@@ -1007,8 +1005,7 @@ impl<'a> Flipper<'a> {
                 )));
             }
         }
-        let mut r = self.tets_of_r();
-        r.sort_unstable();
+        let r = self.tets_of_r();
         for t in r {
             let v = self.cdt.dt.mesh.verts(t);
             if v.iter().all(|x| self.region.verts.contains(x)) {
