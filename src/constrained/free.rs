@@ -165,7 +165,7 @@ fn flip_to_delaunay(cdt: &mut Cdt, changes: &mut Vec<Change>) -> Result<bool, Me
         }
         let old: Vec<(TetId, crate::mesh::Tet)> =
             sh.old.iter().map(|&t| (t, *cdt.dt.mesh.tet(t))).collect();
-        let made = bistellar::replace(&mut cdt.dt.mesh, &sh.old, &sh.new, |_| {})?;
+        let made = bistellar::flip(&mut cdt.dt.mesh, &sh, false, |_| {})?;
         queue.extend(
             made.iter()
                 .flat_map(|&t| (0..4).map(move |i| FaceRef::new(t, i))),
