@@ -16,7 +16,7 @@
 # facets' 2D triangulation, which both report apart), TetGen's its -V line
 # "Facet recovery seconds". Crossing tets: ours (the tets of the initial Delaunay
 # tetrahedralization crossing the rectangle, the same for both of our algorithms).
-# Writes OUTDIR/fig9.csv, then runs scripts/fig9.py for OUTDIR/fig9.png and a summary.
+# Writes OUTDIR/fig9.csv, then runs scripts/fig9.py for OUTDIR/fig9.png and OUTDIR/summary.txt.
 set -uo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -105,4 +105,4 @@ for n in $SIZES; do
     echo "$n,$crossing,$c_secs,$c_status,$f_secs,$f_status,$flips,$fallbacks,$tc,$tl" >>"$CSV"
     echo "n=$n crossing=$crossing -C=${c_secs:-$c_status} -F=${f_secs:-$f_status} tetgen=$tc tetgen-L=$tl" >&2
 done
-python3 "$ROOT/scripts/fig9.py" "$CSV" "$OUT/fig9.png"
+python3 "$ROOT/scripts/fig9.py" "$CSV" "$OUT/fig9.png" | tee "$OUT/summary.txt"

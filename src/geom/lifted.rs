@@ -265,7 +265,16 @@ pub struct FlipTime {
     pub left: [bool; 5],
     i: Approx,
     j: Approx,
-    exact: OnceCell<Box<(Expansion, Expansion)>>,
+    exact: OnceCell<Box<Exact>>,
+}
+
+/// The exact values of a certificate: `I`, `J`, and the minors, whose signed values are
+/// the perturbation coefficients (computed once: a tie may ask for all five).
+#[derive(Clone, Debug)]
+struct Exact {
+    i: Expansion,
+    j: Expansion,
+    minors: [Expansion; 4],
 }
 
 /// Counts of how the comparisons were decided (for tuning and tests).
@@ -322,12 +331,17 @@ impl FlipTime {
         t.flips(lift).then_some(t)
     }
 
-    fn exact(&self, lift: &Lifting) -> &(Expansion, Expansion) {
+    fn exact(&self, lift: &Lifting) -> &Exact {
         self.exact.get_or_init(|| {
             let d: [[Expansion; 3]; 4] = rows(&self.pts);
             let h: [Expansion; 5] =
                 std::array::from_fn(|k| lift.height(&self.pts[k], self.left[k]));
-            Box::new(both_values(&d, &h))
+            let minors = minors(&d);
+            Box::new(Exact {
+                i: insphere_with(&d, &minors),
+                j: height_with(&minors, &h),
+                minors,
+            })
         })
     }
 
@@ -335,7 +349,7 @@ impl FlipTime {
     pub fn flips(&self, lift: &Lifting) -> bool {
         match self.j.sign() {
             Some(s) => s > 0,
-            None => self.exact(lift).1.sign() > 0,
+            None => self.exact(lift).j.sign() > 0,
         }
     }
 
@@ -344,12 +358,24 @@ impl FlipTime {
         -self.i.v / self.j.v
     }
 
-    /// The perturbation coefficient of vertex index `id` (zero if not one of the points).
-    fn coefficient(&self, id: u32) -> Expansion {
-        match self.ids.iter().position(|&x| x == id) {
-            Some(k) => perturbation_coefficient(&rows(&self.pts), k),
-            None => Expansion::zero(),
-        }
+    /// The perturbation coefficient of vertex index `id` (zero if not one of the points):
+    /// [`perturbation_coefficient`], from the kept minors.
+    fn coefficient(&self, id: u32, lift: &Lifting) -> Expansion {
+        let Some(k) = self.ids.iter().position(|&x| x == id) else {
+            return Expansion::zero();
+        };
+        let m = &self.exact(lift).minors;
+        let zero = Expansion::zero();
+        let e: [Expansion; 4] = std::array::from_fn(|i| {
+            if k == 4 {
+                Expansion::from_f64(-1.0)
+            } else if i == k {
+                Expansion::from_f64(1.0)
+            } else {
+                zero.clone()
+            }
+        });
+        with_minors(m, &e)
     }
 }
 
@@ -369,8 +395,8 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         return 0;
     }
     counts.exact += 1;
-    let (ia, ja) = a.exact(lift);
-    let (ib, jb) = b.exact(lift);
+    let (ia, ja) = (&a.exact(lift).i, &a.exact(lift).j);
+    let (ib, jb) = (&b.exact(lift).i, &b.exact(lift).j);
     let s = ib.mul(ja).sub(&ia.mul(jb)).sign();
     if s != 0 {
         return s;
@@ -380,7 +406,10 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
     ids.sort_unstable();
     ids.dedup();
     for id in ids {
-        let c = b.coefficient(id).mul(ja).sub(&a.coefficient(id).mul(jb));
+        let c = b
+            .coefficient(id, lift)
+            .mul(ja)
+            .sub(&a.coefficient(id, lift).mul(jb));
         let s = c.sign();
         if s != 0 {
             return s;
@@ -579,6 +608,36 @@ mod tests {
         let left = p.map(|q| lift.side(&q) > 0);
         let h = std::array::from_fn(|k| lift.height_approx(&p[k], left[k]));
         FlipTime::new(p, ids, left, h)
+    }
+
+    /// The perturbation coefficients read from the kept minors are those of the
+    /// determinant with one lift set (all five points, random values and ties).
+    #[test]
+    fn kept_minors_give_the_perturbation_coefficients() {
+        let lift = Lifting {
+            abc: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        };
+        let mut s = 5u64;
+        for round in 0..200 {
+            let p: [Point; 5] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| {
+                    let x = lcg(&mut s) * 6.0 - 3.0;
+                    if round % 2 == 0 {
+                        x.floor()
+                    } else {
+                        x
+                    }
+                })
+            });
+            let ids = [7, 3, 9, 1, 5];
+            let t = cert(&lift, p, ids);
+            let d: [[Expansion; 3]; 4] = rows(&p);
+            for (k, &id) in ids.iter().enumerate() {
+                let want = perturbation_coefficient(&d, k);
+                assert_eq!(t.coefficient(id, &lift).sub(&want).sign(), 0, "{p:?} {k}");
+            }
+            assert_eq!(t.coefficient(2, &lift).sign(), 0);
+        }
     }
 
     /// Integer reference: `I` and `J` exactly in i128 for small integer coordinates.
