@@ -217,13 +217,15 @@ pub(super) fn flip(
                 .ok_or_else(|| MeshError::Internal("a 3-2 flip without its apex".into()))?;
             let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
             let (e0, e1) = (s[k1], s[k2]);
-            for (a, (gone, kept_slot)) in [(e0, k1), (e1, k2)].into_iter().enumerate() {
+            // `w_slot`: where w took the place of the vertex that is gone.
+            for (a, (gone, w_slot)) in [(e0, k1), (e1, k2)].into_iter().enumerate() {
                 outer[a][k] = Some(mesh.adj(FaceRef::new(t3, pos(mesh, t3, gone)?)));
-                outer[a][kept_slot] = Some(mesh.adj(FaceRef::new(t1, FACE_VERTS[i][kept_slot])));
+                outer[a][w_slot] = Some(mesh.adj(FaceRef::new(t1, FACE_VERTS[i][w_slot])));
                 outer[a][3] = Some(mesh.adj(FaceRef::new(t2, pos(mesh, t2, gone)?)));
             }
         }
-        Kind::T44 => unreachable!(),
+        // Handled above.
+        Kind::T44 => return replace(mesh, &sh.old, &sh.new, |_| {}),
     }
     for &t in sh.old.iter() {
         mesh.kill_tet(t);
