@@ -658,7 +658,7 @@ impl<'a> Flipper<'a> {
                 let now = self.time_from(self.events[cur as usize].verts);
                 if cross_sign(&now, &time, &self.lift, &mut self.cmp) > 0 {
                     self.counts.not_regular += 1;
-                    self.push_event(f, verts, time, true);
+                    self.push_event(f, verts, time.interval(), true);
                 }
             }
         }
@@ -739,6 +739,7 @@ impl<'a> Flipper<'a> {
 
     /// What the flip certificate of five vertices in certificate order needs: their
     /// points, perturbation indices, which are left, and their heights.
+    #[inline(always)]
     fn certificate_of(&self, ids: [VertexId; 5]) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
         // One plain loop: five `array::map`s cost several times more here, where every
         // flip certifies about five faces.
@@ -777,13 +778,15 @@ impl<'a> Flipper<'a> {
     fn certify(&mut self, f: FaceRef) {
         let verts = self.certificate_verts(f);
         let (pts, orig, left, heights) = self.certificate_of(verts);
-        if let Some(time) = FlipTime::if_flips(&self.lift, pts, orig, left, heights) {
-            self.push_event(f, verts, time, false);
+        if let Some(interval) =
+            FlipTime::interval_if_flips(&self.lift, &pts, &orig, &left, &heights)
+        {
+            self.push_event(f, verts, interval, false);
         }
     }
 
-    /// Queues the flip of face `f`, whose certificate `time` is of the five `verts`.
-    fn push_event(&mut self, f: FaceRef, verts: [VertexId; 5], time: FlipTime, forced: bool) {
+    /// Queues the flip of face `f`, certified with the five `verts`, due within `[lo, hi]`.
+    fn push_event(&mut self, f: FaceRef, verts: [VertexId; 5], (lo, hi): (f64, f64), forced: bool) {
         let t2 = self.cdt.dt.mesh.adj(f).tet();
         let e = Event {
             face: f,
@@ -792,7 +795,6 @@ impl<'a> Flipper<'a> {
             g2: self.gens.of(t2),
             verts,
         };
-        let (lo, hi) = time.interval();
         let idx = match self.free_events.pop() {
             Some(i) => {
                 self.events[i as usize] = e;

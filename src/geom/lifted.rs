@@ -331,6 +331,30 @@ impl FlipTime {
         t.flips(lift).then_some(t)
     }
 
+    /// [`FlipTime::if_flips`] followed by [`FlipTime::interval`], without making the
+    /// certificate unless `J`'s sign needs exact arithmetic: queueing a face needs only
+    /// the interval (a certificate is 200 bytes, copied three times on its way).
+    pub fn interval_if_flips(
+        lift: &Lifting,
+        pts: &[Point; 5],
+        ids: &[u32; 5],
+        left: &[bool; 5],
+        h: &[Approx; 5],
+    ) -> Option<(f64, f64)> {
+        let d: [[Approx; 3]; 4] = rows(pts);
+        let m = minors(&d);
+        let j = height_with(&m, h);
+        match j.sign() {
+            Some(s) if s <= 0 => return None,
+            Some(_) => {}
+            None => {
+                let t = FlipTime::if_flips(lift, *pts, *ids, *left, *h)?;
+                return Some(t.interval());
+            }
+        }
+        Some(interval_of(&insphere_with(&d, &m), &j))
+    }
+
     fn exact(&self, lift: &Lifting) -> &Exact {
         self.exact.get_or_init(|| {
             let d: [[Expansion; 3]; 4] = rows(&self.pts);
@@ -364,18 +388,16 @@ impl FlipTime {
         let Some(k) = self.ids.iter().position(|&x| x == id) else {
             return Expansion::zero();
         };
+        // The determinant with lifts (l0, l1, l2, l3) is l3·m3 − l2·m2 + l1·m1 − l0·m0: a
+        // single lift of 1 picks one signed minor; the fifth point's lowers all four.
         let m = &self.exact(lift).minors;
-        let zero = Expansion::zero();
-        let e: [Expansion; 4] = std::array::from_fn(|i| {
-            if k == 4 {
-                Expansion::from_f64(-1.0)
-            } else if i == k {
-                Expansion::from_f64(1.0)
-            } else {
-                zero.clone()
-            }
-        });
-        with_minors(m, &e)
+        match k {
+            0 => Expansion::zero().sub(&m[0]),
+            1 => m[1].clone(),
+            2 => Expansion::zero().sub(&m[2]),
+            3 => m[3].clone(),
+            _ => m[0].sub(&m[1]).add(&m[2]).sub(&m[3]),
+        }
     }
 }
 
@@ -445,31 +467,36 @@ impl FlipTime {
     /// positive or the values leave the analysed range): most heap comparisons are
     /// settled by two of these, with two float comparisons.
     pub fn interval(&self) -> (f64, f64) {
-        let everything = (f64::NEG_INFINITY, f64::INFINITY);
-        let (Some(ei), Some(ej)) = (self.i.err(), self.j.err()) else {
-            return everything;
-        };
-        let (dlo, dhi) = (self.j.v - ej, self.j.v + ej);
-        // Also false for NaN.
-        if dlo.partial_cmp(&0.0) != Some(Ordering::Greater) {
-            return everything;
-        }
-        let (nlo, nhi) = (-self.i.v - ei, -self.i.v + ei);
-        let lo = nlo / if nlo >= 0.0 { dhi } else { dlo };
-        let hi = nhi / if nhi >= 0.0 { dlo } else { dhi };
-        // Each bound went through three roundings (of the numerator, the denominator
-        // and the quotient), each relative to its result; the absolute term covers
-        // subnormal results.
-        let w = 8.0 * f64::EPSILON;
-        let (lo, hi) = (
-            lo - lo.abs() * w - f64::MIN_POSITIVE,
-            hi + hi.abs() * w + f64::MIN_POSITIVE,
-        );
-        if lo.is_nan() || hi.is_nan() {
-            everything
-        } else {
-            (lo, hi)
-        }
+        interval_of(&self.i, &self.j)
+    }
+}
+
+/// [`FlipTime::interval`] of the values `i` and `j`.
+fn interval_of(i: &Approx, j: &Approx) -> (f64, f64) {
+    let everything = (f64::NEG_INFINITY, f64::INFINITY);
+    let (Some(ei), Some(ej)) = (i.err(), j.err()) else {
+        return everything;
+    };
+    let (dlo, dhi) = (j.v - ej, j.v + ej);
+    // Also false for NaN.
+    if dlo.partial_cmp(&0.0) != Some(Ordering::Greater) {
+        return everything;
+    }
+    let (nlo, nhi) = (-i.v - ei, -i.v + ei);
+    let lo = nlo / if nlo >= 0.0 { dhi } else { dlo };
+    let hi = nhi / if nhi >= 0.0 { dlo } else { dhi };
+    // Each bound went through three roundings (of the numerator, the denominator
+    // and the quotient), each relative to its result; the absolute term covers
+    // subnormal results.
+    let w = 8.0 * f64::EPSILON;
+    let (lo, hi) = (
+        lo - lo.abs() * w - f64::MIN_POSITIVE,
+        hi + hi.abs() * w + f64::MIN_POSITIVE,
+    );
+    if lo.is_nan() || hi.is_nan() {
+        everything
+    } else {
+        (lo, hi)
     }
 }
 
