@@ -418,6 +418,12 @@ impl Mesh {
         for t in self.real_tets() {
             let v = self.verts(t);
             for (i, fv) in FACE_VERTS.iter().enumerate() {
+                // Each face once, from the later of its two real tets: the one a pass
+                // over both would have left in the index.
+                let n = self.adj(FaceRef::new(t, i)).tet();
+                if n > t && !self.is_ghost(n) {
+                    continue;
+                }
                 let mut k = [v[fv[0]], v[fv[1]], v[fv[2]]];
                 k.sort_unstable();
                 if rest.of(k[0]).contains(&[k[1], k[2]]) {
