@@ -49,6 +49,9 @@ CORPUS_COPIES = [
     "tetgentests_cgal/blob-closed.off",
     "tetgentests_cgal/eight.off",
     "attene_cdt/flat_cavity_face.off",
+    # Facets meeting at a 0.0012 step: valid only with a point found by another
+    # construction (retries for thick tets on facets, src/constrained/mod.rs).
+    "tetgentests_cgal/mpi.off",
 ]
 
 

@@ -6,6 +6,7 @@
 
 use super::bistellar;
 use super::cdt::{edge_key, face_key, Cdt};
+use super::slivers::Candidate;
 use crate::delaunay::{Change, Walled};
 use crate::error::MeshError;
 use crate::geom::{insphere_sos, Point, Sign};
@@ -21,19 +22,29 @@ pub(super) fn subsegment_ends(cdt: &Cdt) -> VertexLists<VertexId> {
 }
 
 /// Inserts free points into the CDT, one from each list of candidates (the first that
-/// fits), and returns how many it added and the first candidates of the lists it left
-/// out (whose every candidate would break the CDT; the CDT then stays as it was).
+/// fits, and that `accept` takes if it is to be checked), and returns how many it added
+/// and the first candidates of the lists it left out because every candidate would
+/// break the CDT (the CDT then stays as it was). Lists whose first candidate is to be
+/// checked are left out silently.
 pub(super) fn insert_free(
     cdt: &mut Cdt,
-    free: &[Vec<Point>],
+    free: &[Vec<Candidate>],
     next_pert: &mut u32,
+    mut accept: impl FnMut(&Cdt, VertexId) -> bool,
 ) -> Result<(usize, Vec<Point>), MeshError> {
     let at = subsegment_ends(cdt);
     let mut added = 0;
     let mut refused = Vec::new();
     'tets: for ws in free {
-        for &w in ws {
-            match insert_point(cdt, w, *next_pert, &at)? {
+        for c in ws {
+            let inserted = insert_point(cdt, c.at, *next_pert, &at)?;
+            match &inserted {
+                &Inserted::Yes { vertex, .. } if c.checked && !accept(cdt, vertex) => {
+                    if super::debug() {
+                        eprintln!("point {:?}: a tet around it lies on a facet", c.at);
+                    }
+                    take_back(cdt, inserted);
+                }
                 Inserted::Yes { .. } => {
                     *next_pert += 1;
                     added += 1;
@@ -43,7 +54,7 @@ pub(super) fn insert_free(
                 Inserted::OnVertex => continue 'tets,
             }
         }
-        refused.extend(ws.first());
+        refused.extend(ws.first().filter(|c| !c.checked).map(|c| c.at));
     }
     Ok((added, refused))
 }

@@ -201,6 +201,10 @@ const FREE_POINT: usize = usize::MAX;
 /// Marks the failure to triangulate a merged group in one plane (then split).
 const UNFLAT_GROUP: &str = "merged facets ";
 
+/// At most this many tets left on facets are worth other constructions (fans of needle
+/// triangles leave many, which no single point removes).
+const MAX_RETRY_TETS: usize = 4;
+
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 24;
 
@@ -301,10 +305,24 @@ pub fn mesh_plc_with_progress(
     let mut facet_points: Vec<(usize, Point)> = Vec::new();
     let mut presplits: Vec<(usize, f64)> = Vec::new();
     let mut first_work = 0u64;
-    loop {
+    // A construction that leaves a few thick tets on facets is followed by others, each
+    // started with one point off such a tet's facet; the first that leaves none is
+    // taken, else the first construction.
+    let stats0 = stats.clone();
+    let mut retry: Option<Retry> = None;
+    // Set when the retries are over without one that does better.
+    let mut exhausted = false;
+    let built = loop {
+        if exhausted {
+            if let Some(r) = retry.take() {
+                let (b, st, fp) = r.fallback;
+                (stats, facet_points) = (st, fp);
+                break b;
+            }
+        }
         opts.check_cancel()?;
         let prep = split.as_ref().unwrap_or(&base);
-        let outcome = match attempt(
+        let result = match attempt(
             plc,
             first_dt.take(),
             [prep, merged],
@@ -313,7 +331,9 @@ pub fn mesh_plc_with_progress(
             &mut stats,
             progress,
         ) {
-            Err(Error::Mesh(MeshError::Failed(msg))) if msg.starts_with(UNFLAT_GROUP) => {
+            Err(Error::Mesh(MeshError::Failed(msg)))
+                if msg.starts_with(UNFLAT_GROUP) && retry.is_none() =>
+            {
                 // Which group failed is in the message; split it and start again.
                 let sources: Vec<usize> = msg[UNFLAT_GROUP.len()..]
                     .split(':')
@@ -333,37 +353,87 @@ pub fn mesh_plc_with_progress(
                 presplits.clear();
                 continue;
             }
-            r => r?,
+            r => r,
+        };
+        // In a retry, a failed construction only moves on to the next point.
+        let outcome = match (result, retry.as_mut()) {
+            (Ok(o), _) => o,
+            (Err(e), None) => return Err(e),
+            (Err(_), Some(r)) => match r.next(&stats0) {
+                Some(state) => {
+                    (facet_points, presplits, stats, first_work) = state;
+                    continue;
+                }
+                None => {
+                    exhausted = true;
+                    continue;
+                }
+            },
         };
         match outcome {
-            Attempt::Done(built) => {
-                let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
-                stats.facet_steiner_points += facet_points.len() - free;
-                stats.free_steiner_points += free;
-                let (flat, first) = built.flat_left;
-                stats.flat_tets_left = flat;
-                if let Some(f) = first.filter(|_| flat > 0) {
-                    warnings.push(format!(
-                        "{flat} flat tet(s) with all four vertices on one facet remain, the \
-                         first on facet {}: steps or dents of facets that are not flat, which \
-                         no free Steiner point could remove (checks for shim tets flag them)",
-                        facet_name(plc, &merged.facets[f as usize])
-                    ));
+            Attempt::Done(built) => match retry.as_mut() {
+                None if !built.retry_points.is_empty() => {
+                    if debug() {
+                        eprintln!("{} tets left on facets: retries", built.flat_left.0);
+                    }
+                    let points = built.retry_points.clone();
+                    let r = retry.insert(Retry {
+                        fallback: (built, stats.clone(), facet_points.clone()),
+                        points,
+                        next: 0,
+                    });
+                    (facet_points, presplits, stats, first_work) = r.start(&stats0);
+                    continue;
                 }
-                let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
-                return Ok(PlcMesh {
-                    mesh,
-                    stats,
-                    warnings,
-                });
-            }
+                None => break built,
+                Some(r) => {
+                    if debug() {
+                        eprintln!(
+                            "retry with {:?}: {} left, covering {}",
+                            r.points[r.next], built.flat_left.0, built.first_point_covers
+                        );
+                    }
+                    if built.flat_left.0 == 0 && !built.first_point_covers {
+                        break built;
+                    }
+                    match r.next(&stats0) {
+                        Some(state) => {
+                            (facet_points, presplits, stats, first_work) = state;
+                            continue;
+                        }
+                        None => {
+                            exhausted = true;
+                            continue;
+                        }
+                    }
+                }
+            },
             Attempt::Restart(more, splits) => {
                 stats.restarts += 1;
                 if stats.restarts == 1 {
                     first_work = stats.crossing_tests;
                 }
                 if debug() {
-                    eprintln!("restart {}", stats.restarts);
+                    eprintln!("restart {} with {:?} {:?}", stats.restarts, more, splits);
+                }
+                if let Some(r) = retry.as_mut() {
+                    let over = stats.restarts > MAX_RESTARTS
+                        || facet_points.len() + more.len() > opts.max_steiner
+                        || facet_points.len() + more.len() + presplits.len() + splits.len()
+                            > max_facet_points(plc)
+                        || stats.crossing_tests > RESTART_WORK + 8 * first_work;
+                    if over {
+                        match r.next(&stats0) {
+                            Some(state) => {
+                                (facet_points, presplits, stats, first_work) = state;
+                            }
+                            None => {
+                                exhausted = true;
+                                continue;
+                            }
+                        }
+                        continue;
+                    }
                 }
                 if facet_points.len() + more.len() > opts.max_steiner {
                     return Err(MeshError::Failed(format!(
@@ -389,6 +459,57 @@ pub fn mesh_plc_with_progress(
                 presplits.extend(splits);
             }
         }
+    };
+    let prep = split.as_ref().unwrap_or(&base);
+    let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
+    stats.facet_steiner_points += facet_points.len() - free;
+    stats.free_steiner_points += free;
+    let (flat, first) = built.flat_left;
+    stats.flat_tets_left = flat;
+    if let Some(f) = first.filter(|_| flat > 0) {
+        warnings.push(format!(
+            "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
+             {}: steps or dents of facets that are not flat, which no free Steiner point \
+             could remove (checks for shim tets flag them)",
+            facet_name(plc, &merged.facets[f as usize])
+        ));
+    }
+    let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
+    Ok(PlcMesh {
+        mesh,
+        stats,
+        warnings,
+    })
+}
+
+/// The state of the constructions that follow one leaving a few thick tets on facets.
+struct Retry {
+    /// The first construction, with its figures and points: taken if no retry does better.
+    fallback: (Box<Built>, PlcStats, Vec<FacetPoint>),
+    /// The points to start the others with, one each.
+    points: Vec<Point>,
+    /// The one being tried.
+    next: usize,
+}
+
+/// What a construction starts from: its points, splits, figures and first work.
+type StartState = (Vec<FacetPoint>, Vec<SegmentSplit>, PlcStats, u64);
+
+impl Retry {
+    /// The state to start the construction with the current point.
+    fn start(&self, stats0: &PlcStats) -> StartState {
+        (
+            vec![(FREE_POINT, self.points[self.next])],
+            Vec::new(),
+            stats0.clone(),
+            0,
+        )
+    }
+
+    /// Moves on to the next point, if there is one.
+    fn next(&mut self, stats0: &PlcStats) -> Option<StartState> {
+        self.next += 1;
+        (self.next < self.points.len()).then(|| self.start(stats0))
     }
 }
 
@@ -402,6 +523,12 @@ struct Built {
     /// How many flat tets lie on one facet (of the all-merged facets), and the facet of
     /// the first.
     flat_left: (usize, Option<u32>),
+    /// When a few tets are left on facets: points for another construction that may
+    /// leave none (see [`slivers::retry_points`]).
+    retry_points: Vec<Point>,
+    /// Whether a face around the first earlier point (a retry's own point) lies on a
+    /// facet beside its triangles.
+    first_point_covers: bool,
 }
 
 /// A Steiner point found by an earlier attempt: (merged facet or [`FREE_POINT`], point).
@@ -663,6 +790,7 @@ fn attempt(
             regions: &plc.regions,
             keep_hull: opts.keep_hull,
         },
+        index: Default::default(),
     };
     // The flat tets left on facets, when known (`None` after points went in).
     let mut flat_left: Option<(usize, Option<u32>)> = None;
@@ -687,7 +815,9 @@ fn attempt(
             if free.is_empty() {
                 break;
             }
-            let (added, refused) = free::insert_free(&mut cdt, free, &mut next_pert)?;
+            let (added, refused) = free::insert_free(&mut cdt, free, &mut next_pert, |cdt, v| {
+                !search.on_facet_around(cdt, v)
+            })?;
             stats.free_steiner_points += added;
             if added > 0 {
                 carved = None;
@@ -736,11 +866,27 @@ fn attempt(
             slivers::flat_left(&mut cdt, search, &mut carved)
         }
     };
+    let retry_points = if (1..=MAX_RETRY_TETS).contains(&flat_left.0) {
+        let search = search.get_or_insert_with(|| make_search(&cdt));
+        slivers::retry_points(&mut cdt, search, &mut carved)
+    } else {
+        Vec::new()
+    };
+    let first_point_covers = match facet_points.first() {
+        Some(&(FREE_POINT, _)) => {
+            let v = inv.get(n_input).copied().filter(|&v| v != u32::MAX);
+            let search = search.get_or_insert_with(|| make_search(&cdt));
+            v.is_some_and(|v| search.covering_face_around(&cdt, v))
+        }
+        _ => false,
+    };
     Ok(Attempt::Done(Box::new(Built {
         cdt,
         seg_markers,
         carved,
         flat_left,
+        retry_points,
+        first_point_covers,
     })))
 }
 
@@ -1314,6 +1460,8 @@ fn finish(
         seg_markers,
         carved,
         flat_left: _,
+        retry_points: _,
+        first_point_covers: _,
     } = built;
     let t = Instant::now();
     let carved =

@@ -14,6 +14,7 @@ use crate::geom::{cross, dot, sub, Point};
 use crate::mesh::VertexId;
 use crate::plc::Region;
 use rustc_hash::FxHashMap;
+use std::cell::{OnceCell, RefCell};
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
 /// referee's measure (1e-3) with a margin, so that what we remove is what it flags.
@@ -48,51 +49,205 @@ pub(crate) struct Domain<'a> {
     pub keep_hull: bool,
 }
 
-/// What the search for flat tets on facets needs besides the CDT: the facets as merged
+/// What the search for tets on facets needs besides the CDT: the facets as merged
 /// (`prep`), the input points, the input ends of the segment of each Steiner point on
-/// one (which name the facets a flat tet of such points may lie on), and the domain.
+/// one (which name the facets a tet of such points may lie on), and the domain.
 pub(crate) struct Search<'a> {
     pub prep: &'a PreparedPlc,
     pub input: &'a [Point],
     pub seg_ends: FxHashMap<VertexId, [u32; 2]>,
     pub domain: Domain<'a>,
+    /// Which facets each input vertex is on, and the facets' slabs: made when first
+    /// needed.
+    pub index: OnceCell<FacetIndex>,
+}
+
+/// Which facets each input vertex is on, and the facets' slabs, built on demand (most
+/// facets never hold a tet of their own vertices).
+pub(crate) struct FacetIndex {
+    on_facets: crate::mesh::VertexLists<u32>,
+    slabs: RefCell<Vec<Option<Option<Slab>>>>,
+    diag: f64,
+}
+
+impl Search<'_> {
+    fn index(&self) -> &FacetIndex {
+        self.index.get_or_init(|| FacetIndex {
+            on_facets: crate::mesh::VertexLists::new(
+                self.input.len(),
+                self.prep
+                    .facets
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| f.normal != [0.0; 3])
+                    .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
+            ),
+            slabs: RefCell::new(vec![None; self.prep.facets.len()]),
+            diag: diagonal(self.input),
+        })
+    }
+
+    /// Facet `fi`'s slab, if it has one.
+    fn slab(&self, fi: usize) -> Option<Slab> {
+        let index = self.index();
+        index.slabs.borrow_mut()[fi]
+            .get_or_insert_with(|| slab_of(self.prep, self.input, index.diag, fi))
+            .clone()
+    }
+
+    /// The facet that the tet's four vertices all lie on, if any: input vertices by the
+    /// facets' rings, Steiner points by the facets' slabs. The lowest such facet is
+    /// named.
+    fn facet_of(&self, cdt: &Cdt, v: [VertexId; 4]) -> Option<u32> {
+        let n_input = self.input.len();
+        let index = self.index();
+        let p = v.map(|x| cdt.dt.points[x as usize]);
+        let o = v.map(|x| cdt.dt.orig[x as usize]);
+        let on = |i: usize, f: u32| -> bool {
+            if (o[i] as usize) < n_input {
+                index.on_facets.of(o[i]).contains(&f)
+            } else {
+                self.slab(f as usize).is_some_and(|s| s.holds(&p[i]))
+            }
+        };
+        // With an input vertex, the facets the tet can lie on are among that vertex's
+        // (the shortest such list is tried, in increasing order). Most tets go this way.
+        if let Some(x) = (0..4)
+            .filter(|&i| (o[i] as usize) < n_input)
+            .min_by_key(|&i| index.on_facets.of(o[i]).len())
+        {
+            return index
+                .on_facets
+                .of(o[x])
+                .iter()
+                .copied()
+                .find(|&f| (0..4).all(|i| on(i, f)));
+        }
+        // A tet of Steiner points on segments (between nearly parallel segments) has no
+        // input vertex to name its facet: the segments' ends do. The lowest facet of
+        // theirs that holds all four is taken (each list is increasing).
+        let mut best: Option<u32> = None;
+        for x in v.iter().filter_map(|x| self.seg_ends.get(x)).flatten() {
+            for &f in index.on_facets.of(*x) {
+                if best.is_some_and(|b| b <= f) {
+                    break;
+                }
+                if (0..4).all(|i| on(i, f)) {
+                    best = Some(f);
+                }
+            }
+        }
+        best
+    }
+
+    /// Whether the faces around vertex `v` that are not subfaces but have their three
+    /// vertices on one facet cover more than a trace of it (projected on the facet's
+    /// normal, together over a millionth of its area, the referee's tolerance): they
+    /// would lie on the facet beside its triangles.
+    pub(crate) fn covering_face_around(&self, cdt: &Cdt, v: VertexId) -> bool {
+        let mut star = Vec::new();
+        cdt.dt.star(v, &mut star);
+        let mut covered: Vec<(u32, f64)> = Vec::new();
+        for &t in star.iter().filter(|&&t| !cdt.is_ghost(t)) {
+            for (i, &x) in cdt.dt.mesh.verts(t).iter().enumerate() {
+                // The faces through `v`: those opposite its other vertices.
+                if x == v || cdt.is_subface(t, i) {
+                    continue;
+                }
+                let f = cdt.dt.mesh.face_verts(t, i);
+                let Some(fi) = self.facet_of(cdt, [f[0], f[1], f[2], f[2]]) else {
+                    continue;
+                };
+                let Some(slab) = self.slab(fi as usize) else {
+                    continue;
+                };
+                let q = f.map(|x| cdt.dt.points[x as usize]);
+                let n = cross(&sub(&q[1], &q[0]), &sub(&q[2], &q[0]));
+                // Each face is seen from both its tets around `v`: halved.
+                let area = 0.25 * dot(&n, &slab.normal).abs();
+                match covered.iter_mut().find(|(f, _)| *f == fi) {
+                    Some((_, a)) => *a += area,
+                    None => covered.push((fi, area)),
+                }
+            }
+        }
+        covered.iter().any(|&(fi, a)| {
+            self.slab(fi as usize)
+                .is_some_and(|s| a > 1e-6 * self.facet_area(fi as usize, &s.normal))
+        })
+    }
+
+    /// The area of merged facet `fi` projected on `normal`.
+    fn facet_area(&self, fi: usize, normal: &Point) -> f64 {
+        let mut total = 0.0;
+        for ring in &self.prep.facets[fi].rings {
+            let mut n = [0.0; 3];
+            for (k, &a) in ring.iter().enumerate() {
+                let b = ring[(k + 1) % ring.len()];
+                let (pa, pb) = (self.input[a as usize], self.input[b as usize]);
+                n[0] += (pa[1] - pb[1]) * (pa[2] + pb[2]);
+                n[1] += (pa[2] - pb[2]) * (pa[0] + pb[0]);
+                n[2] += (pa[0] - pb[0]) * (pa[1] + pb[1]);
+            }
+            total += 0.5 * dot(&n, normal).abs();
+        }
+        total
+    }
+
+    /// Whether some tet around vertex `v` has all four vertices on one facet.
+    pub(crate) fn on_facet_around(&self, cdt: &Cdt, v: VertexId) -> bool {
+        let mut star = Vec::new();
+        cdt.dt.star(v, &mut star);
+        star.iter().filter(|&&t| !cdt.is_ghost(t)).any(|&t| {
+            let f = self.facet_of(cdt, cdt.dt.mesh.verts(t));
+            if super::debug() && f.is_some() {
+                eprintln!(
+                    "  around: {:?} on {f:?} flat {}",
+                    cdt.dt.mesh.verts(t),
+                    is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]))
+                );
+            }
+            f.is_some()
+        })
+    }
+}
+
+/// A free vertex that may remove a tet on a facet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Candidate {
+    pub at: Point,
+    /// It lies in some facet's slab, or its tet is not flat: once in, it stays only if
+    /// no tet around it has all four vertices on one facet.
+    pub checked: bool,
 }
 
 /// What [`free_points`] found.
 #[derive(Default)]
 pub(crate) struct FlatTets {
-    /// Free vertices that remove flat tets: for each tet, the candidates in order of
-    /// preference (a point that would break the CDT, by encroaching upon a subsegment,
-    /// gives way to the next).
-    pub points: Vec<Vec<Point>>,
+    /// Free vertices that remove tets on facets: for each tet, the candidates in order
+    /// of preference (a point that would break the CDT, by encroaching upon a
+    /// subsegment, or that a check refuses, gives way to the next).
+    pub points: Vec<Vec<Candidate>>,
     /// The kept flat tets for which no free vertex was found (their circumspheres lie
     /// within the facet's slab), by their vertices.
     pub stuck: Vec<[crate::mesh::VertexId; 4]>,
-    /// How many flat tets on facets there are, and the facet of the first.
+    /// How many tets on facets there are, and the facet of the first.
     pub found: (usize, Option<u32>),
 }
 
-/// What [`find_flat`] found, and what it built on the way that placing free points needs.
+/// The tets on facets that carving keeps: each with its facet and whether it is flat.
 struct Found {
-    /// The flat tets that carving keeps and that lie on one facet, each with that facet.
-    flat: Vec<(crate::mesh::TetId, u32)>,
-    /// The facets' slabs (`None` where not built yet).
-    slabs: Vec<Option<Option<Slab>>>,
+    tets: Vec<(crate::mesh::TetId, u32, bool)>,
     /// Which tet slots carving keeps.
     kept: Vec<bool>,
-    /// The input's bounding-box diagonal.
-    diag: f64,
 }
 
-/// Finds the flat tets that carving keeps and that lie on one facet (see [`Found`]);
-/// `None` if there are none. `carved` is the CDT's carving if known, and is set if made.
+/// Finds the tets that carving keeps and whose four vertices lie on one facet: flat
+/// ones, and thick ones squashed within the slab of a facet that bends (their faces
+/// would lie on the facet beside its triangles); `None` if there are none. `carved` is
+/// the CDT's carving if known, and is set if made.
 fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) -> Option<Found> {
-    let Search {
-        prep,
-        input,
-        seg_ends,
-        domain,
-    } = search;
+    let Search { prep, input, .. } = search;
     // A tet can lie on one facet only if it has a Steiner point (which may lie in a
     // slab), or if its four input vertices share a facet, which then has four or more:
     // that rules out most tets before any geometry.
@@ -109,112 +264,51 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
         let o = v.map(|x| cdt.dt.orig[x as usize] as usize);
         o.iter().any(|&x| x >= n_input) || o.iter().all(|&x| on_big[x])
     };
-    // Flat tets are few: find them before building the facets' slabs.
-    let flat_tets: Vec<crate::mesh::TetId> = cdt
+    let tets: Vec<(crate::mesh::TetId, u32, bool)> = cdt
         .dt
         .mesh
         .live_tets()
         .filter(|&t| !cdt.is_ghost(t) && candidate(cdt.dt.mesh.verts(t)))
-        .filter(|&t| is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize])))
+        .filter_map(|t| {
+            let v = cdt.dt.mesh.verts(t);
+            let f = search.facet_of(cdt, v)?;
+            Some((t, f, is_flat(&v.map(|x| cdt.dt.points[x as usize]))))
+        })
         .collect();
-    if flat_tets.is_empty() {
+    if tets.is_empty() {
         return None;
     }
     // Only kept tets matter, and the carving is needed anyway (the output reuses it):
-    // flat tets outside the domain, often many, are dropped before any facet is looked at.
+    // tets outside the domain, often many, are dropped here.
     let kept = carved
-        .get_or_insert_with(|| carve(cdt, domain.holes, domain.regions, domain.keep_hull))
+        .get_or_insert_with(|| {
+            carve(
+                cdt,
+                search.domain.holes,
+                search.domain.regions,
+                search.domain.keep_hull,
+            )
+        })
         .kept_mask(cdt.dt.mesh.num_slots());
-    let flat_tets: Vec<crate::mesh::TetId> = flat_tets
-        .into_iter()
-        .filter(|&t| kept[t as usize])
-        .collect();
-    if flat_tets.is_empty() {
-        return None;
+    let tets: Vec<_> = tets.into_iter().filter(|x| kept[x.0 as usize]).collect();
+    if super::debug() {
+        eprintln!("tets on facets {tets:?}");
     }
-    let diag = diagonal(input);
-    // Which facets each input vertex is on, as lists per vertex (one flat array).
-    let on_facets = crate::mesh::VertexLists::new(
-        n_input,
-        prep.facets
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| f.normal != [0.0; 3])
-            .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
-    );
-    let facets_of = |v: u32| on_facets.of(v);
-    // Slabs are built on demand: most facets never hold a flat tet.
-    let slab_of = |fi: usize| slab_of(prep, input, diag, fi);
-    let mut slab_cache: Vec<Option<Option<Slab>>> = Vec::new();
-    slab_cache.resize_with(prep.facets.len(), || None);
-    let mut on = |orig: u32, p: &Point, f: u32| -> bool {
-        if (orig as usize) < n_input {
-            facets_of(orig).contains(&f)
-        } else {
-            slab_cache[f as usize]
-                .get_or_insert_with(|| slab_of(f as usize))
-                .as_ref()
-                .is_some_and(|s| s.holds(p))
-        }
-    };
-    let mut flat: Vec<(crate::mesh::TetId, u32)> = Vec::new();
-    for t in flat_tets {
-        let v = cdt.dt.mesh.verts(t);
-        let p = v.map(|x| cdt.dt.points[x as usize]);
-        let o = v.map(|x| cdt.dt.orig[x as usize]);
-        // With an input vertex, the facets the tet can lie on are among that vertex's
-        // (the shortest such list is tried, in increasing order: the first facet found
-        // is the lowest of all candidates, as below). Most flat tets go this way.
-        if let Some(x) = (0..4)
-            .filter(|&i| (o[i] as usize) < n_input)
-            .min_by_key(|&i| facets_of(o[i]).len())
-        {
-            if let Some(&f) = facets_of(o[x])
-                .iter()
-                .find(|&&f| (0..4).all(|i| on(o[i], &p[i], f)))
-            {
-                flat.push((t, f));
-            }
-            continue;
-        }
-        // A tet of Steiner points on segments (between nearly parallel segments) has no
-        // input vertex to name its facet: the segments' ends do. The lowest facet of
-        // theirs that holds all four is taken (each list is increasing).
-        let mut best: Option<u32> = None;
-        for x in v.iter().filter_map(|x| seg_ends.get(x)).flatten() {
-            for &f in facets_of(*x) {
-                if best.is_some_and(|b| b <= f) {
-                    break;
-                }
-                if (0..4).all(|i| on(o[i], &p[i], f)) {
-                    best = Some(f);
-                }
-            }
-        }
-        if let Some(f) = best {
-            flat.push((t, f));
-        }
-    }
-    (!flat.is_empty()).then_some(Found {
-        flat,
-        slabs: slab_cache,
-        kept,
-        diag,
-    })
+    (!tets.is_empty()).then_some(Found { tets, kept })
 }
 
-/// How many flat tets that carving keeps lie on one facet, and the facet of the first:
-/// what is left once no free point removes any more. `carved` as in [`free_points`].
+/// How many tets that carving keeps lie on one facet, and the facet of the first: what
+/// is left once no free point removes any more. `carved` as in [`free_points`].
 pub(crate) fn flat_left(
     cdt: &mut Cdt,
     search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> (usize, Option<u32>) {
     find_flat(cdt, search, carved)
-        .map_or((0, None), |f| (f.flat.len(), f.flat.first().map(|x| x.1)))
+        .map_or((0, None), |f| (f.tets.len(), f.tets.first().map(|x| x.1)))
 }
 
-/// Free vertices that remove the flat tets lying on one facet, one per such tet, and
+/// Free vertices that remove the tets lying on one facet, a list for each such tet, and
 /// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
 /// if made.
 pub(crate) fn free_points(
@@ -222,35 +316,82 @@ pub(crate) fn free_points(
     search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> FlatTets {
-    let Some(Found {
-        flat,
-        slabs,
-        kept,
-        diag,
-    }) = find_flat(cdt, search, carved)
-    else {
+    let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
         return FlatTets::default();
     };
-    // A free point must leave every facet's slab: all are needed from here on.
-    let slabs: Vec<Option<Slab>> = slabs
-        .into_iter()
-        .enumerate()
-        .map(|(fi, s)| s.unwrap_or_else(|| slab_of(search.prep, search.input, diag, fi)))
+    // A free point is sought off every facet's slab first: all are needed from here on.
+    let slabs: Vec<Option<Slab>> = (0..search.prep.facets.len())
+        .map(|fi| search.slab(fi))
         .collect();
     let mut out = FlatTets {
-        found: (flat.len(), flat.first().map(|x| x.1)),
+        found: (tets.len(), tets.first().map(|x| x.1)),
         ..Default::default()
     };
-    for (t, f) in flat {
+    for (t, f, flat) in tets {
         let Some(slab) = slabs[f as usize].as_ref() else {
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        let ws = remover(cdt, &kept, t, &p, slab, &slabs);
-        if ws.is_empty() {
+        let ws = remover(cdt, &kept, t, &p, flat, slab, &slabs);
+        // A flat tet with no point off every slab may still be split (see `mod.rs`)
+        // if the checked points fail.
+        if flat && ws.first().is_none_or(|c| c.checked) {
             out.stuck.push(cdt.dt.mesh.verts(t));
-        } else if !out.points.iter().any(|x| x[0] == ws[0]) {
+        }
+        // A thick tet whose sphere holds an earlier tet's first point goes with it: two
+        // points close together would make tets as bad.
+        let o = orient3d(&p[0], &p[1], &p[2], &p[3]).signum();
+        let taken = |w: &Candidate| {
+            out.points.iter().any(|x| {
+                x[0] == *w || (!flat && insphere(&p[0], &p[1], &p[2], &p[3], &x[0].at) * o > 0.0)
+            })
+        };
+        if ws.first().is_some_and(|w| !taken(w)) {
             out.points.push(ws);
+        }
+    }
+    out
+}
+
+/// Points for another construction when a few thick tets are left on facets (see
+/// `mod.rs`): just off the first such tet's facet's slab, on lines along the facet's
+/// normal through points a quarter of the way from its circumcenter to each of its
+/// vertices, then through the circumcenter; inside the domain. Such a tet sits where
+/// facets meet at a step, the CDT lets no point into its sphere in place, and which of
+/// these places leaves no tet on any facet only a construction tells.
+pub(crate) fn retry_points(
+    cdt: &mut Cdt,
+    search: &Search<'_>,
+    carved: &mut Option<Carved>,
+) -> Vec<Point> {
+    let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
+        return Vec::new();
+    };
+    let Some(&(t, f, _)) = tets.iter().find(|x| !x.2) else {
+        return Vec::new();
+    };
+    let Some(slab) = search.slab(f as usize) else {
+        return Vec::new();
+    };
+    let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
+    let Some((c, _)) = circumsphere(&p) else {
+        return Vec::new();
+    };
+    let mut out: Vec<Point> = Vec::new();
+    let bases = p
+        .iter()
+        .map(|v| std::array::from_fn(|k| c[k] + 0.25 * (v[k] - c[k])))
+        .chain(std::iter::once(c));
+    for b in bases {
+        for side in [-1.0, 1.0] {
+            let lift = side * slab.tol * 1.03 - slab.height(&b);
+            let w: Point = std::array::from_fn(|k| b[k] + lift * slab.normal[k]);
+            if out.contains(&w) {
+                continue;
+            }
+            if containing_tet_near(cdt, t, &w).is_some_and(|x| kept[x as usize]) {
+                out.push(w);
+            }
         }
     }
     out
@@ -306,22 +447,28 @@ fn is_flat(p: &[Point; 4]) -> bool {
     det.abs() / 6.0 <= FLAT * l2 * l2.sqrt()
 }
 
-/// The number of places [`remover`] offers for one flat tet.
+/// The number of places [`remover`] offers for one tet.
 const CANDIDATES: usize = 6;
 
-/// Points inside the tet's circumsphere, off every facet's slab and inside a kept tet,
-/// best first. They are sought on lines along the facet's normal through the tet's
-/// centroid, its circumcenter and the point halfway, farthest from the facet first: a
-/// flat tet along an edge where two facets meet has its sphere off to one side.
+/// Points inside the tet's circumsphere and inside a kept tet, best first. They are
+/// sought on lines along the facet's normal through the tet's centroid, its
+/// circumcenter and the point halfway, farthest from the facet first: a flat tet along
+/// an edge where two facets meet has its sphere off to one side.
+///
+/// Points off every facet's slab come first. A thick tet's sphere is small, and where
+/// facets meet at a step it may lie within another facet's slab: then points off its
+/// own facet's slab follow, near the far side of the sphere too, and each must pass a
+/// check once in (see [`Candidate`]).
 fn remover(
     cdt: &mut Cdt,
     kept: &[bool],
     tet: crate::mesh::TetId,
     p: &[Point; 4],
+    flat: bool,
     slab: &Slab,
     slabs: &[Option<Slab>],
-) -> Vec<Point> {
-    let mut found = Vec::new();
+) -> Vec<Candidate> {
+    let mut found: Vec<Candidate> = Vec::new();
     let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
     if o == 0.0 {
         return found;
@@ -357,24 +504,40 @@ fn remover(
         dirs.push(n);
     }
     let inside = |w: &Point| insphere(&p[0], &p[1], &p[2], &p[3], w) * o.signum() > 0.0;
-    for frac in [0.5, 0.3, 0.15, 0.05, 0.0] {
-        for &(b, scale) in &bases {
-            for (d, s) in dirs.iter().flat_map(|d| [(d, 1.0), (d, -1.0)]) {
-                let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
-                // Off every facet's slab: near one it could form flat tets there.
-                if !inside(&w) || slabs.iter().flatten().any(|s| s.holds(&w)) {
-                    continue;
-                }
-                if found.contains(&w) {
-                    continue;
-                }
-                if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
-                    found.push(w);
-                    if found.len() == CANDIDATES {
-                        return found;
+    let fracs: &[f64] = if flat {
+        &[0.5, 0.3, 0.15, 0.05, 0.0]
+    } else {
+        &[0.95, 0.8, 0.5, 0.3, 0.15, 0.05, 0.0]
+    };
+    for strict in [true, false] {
+        for &frac in fracs {
+            for &(b, scale) in &bases {
+                for (d, s) in dirs.iter().flat_map(|d| [(d, 1.0), (d, -1.0)]) {
+                    let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
+                    // Off every facet's slab (near one it could form flat tets there),
+                    // or, failing that, off the tet's own.
+                    let off = if strict {
+                        !slabs.iter().flatten().any(|s| s.holds(&w))
+                    } else {
+                        !slab.holds(&w)
+                    };
+                    if !off || !inside(&w) || found.iter().any(|c| c.at == w) {
+                        continue;
+                    }
+                    if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
+                        found.push(Candidate {
+                            at: w,
+                            checked: !strict || !flat,
+                        });
+                        if found.len() == CANDIDATES {
+                            return found;
+                        }
                     }
                 }
             }
+        }
+        if !found.is_empty() {
+            break;
         }
     }
     found
