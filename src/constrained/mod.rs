@@ -414,7 +414,7 @@ pub fn mesh_plc_with_progress(
                     first_work = stats.crossing_tests;
                 }
                 if debug() {
-                    eprintln!("restart {} with {:?} {:?}", stats.restarts, more, splits);
+                    eprintln!("restart {}", stats.restarts);
                 }
                 if let Some(r) = retry.as_mut() {
                     let over = stats.restarts > MAX_RESTARTS
