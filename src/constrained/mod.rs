@@ -310,14 +310,22 @@ pub fn mesh_plc_with_progress(
     // taken, else the first construction.
     let stats0 = stats.clone();
     let mut retry: Option<Retry> = None;
-    // Set when the retries are over without one that does better.
-    let mut exhausted = false;
+    // Set when a retry's construction fails or does no better: the next point is tried,
+    // or, when none is left, the first construction is taken.
+    let mut retry_failed = false;
     let built = loop {
-        if exhausted {
-            if let Some(r) = retry.take() {
-                let (b, st, fp) = r.fallback;
-                (stats, facet_points) = (st, fp);
-                break b;
+        if std::mem::take(&mut retry_failed) {
+            if let Some(r) = retry.as_mut() {
+                match r.next(&stats0) {
+                    Some(state) => (facet_points, presplits, stats, first_work) = state,
+                    None => {
+                        if let Some(r) = retry.take() {
+                            let (b, st, fp) = r.fallback;
+                            (stats, facet_points) = (st, fp);
+                            break b;
+                        }
+                    }
+                }
             }
         }
         opts.check_cancel()?;
@@ -356,19 +364,13 @@ pub fn mesh_plc_with_progress(
             r => r,
         };
         // In a retry, a failed construction only moves on to the next point.
-        let outcome = match (result, retry.as_mut()) {
-            (Ok(o), _) => o,
-            (Err(e), None) => return Err(e),
-            (Err(_), Some(r)) => match r.next(&stats0) {
-                Some(state) => {
-                    (facet_points, presplits, stats, first_work) = state;
-                    continue;
-                }
-                None => {
-                    exhausted = true;
-                    continue;
-                }
-            },
+        let outcome = match result {
+            Ok(o) => o,
+            Err(_) if retry.is_some() => {
+                retry_failed = true;
+                continue;
+            }
+            Err(e) => return Err(e),
         };
         match outcome {
             Attempt::Done(built) => match retry.as_mut() {
@@ -396,16 +398,8 @@ pub fn mesh_plc_with_progress(
                     if built.flat_left.0 == 0 && !built.first_point_covers {
                         break built;
                     }
-                    match r.next(&stats0) {
-                        Some(state) => {
-                            (facet_points, presplits, stats, first_work) = state;
-                            continue;
-                        }
-                        None => {
-                            exhausted = true;
-                            continue;
-                        }
-                    }
+                    retry_failed = true;
+                    continue;
                 }
             },
             Attempt::Restart(more, splits) => {
@@ -416,39 +410,25 @@ pub fn mesh_plc_with_progress(
                 if debug() {
                     eprintln!("restart {}", stats.restarts);
                 }
-                if let Some(r) = retry.as_mut() {
-                    let over = stats.restarts > MAX_RESTARTS
-                        || facet_points.len() + more.len() > opts.max_steiner
-                        || facet_points.len() + more.len() + presplits.len() + splits.len()
-                            > max_facet_points(plc)
-                        || stats.crossing_tests > RESTART_WORK + 8 * first_work;
-                    if over {
-                        match r.next(&stats0) {
-                            Some(state) => {
-                                (facet_points, presplits, stats, first_work) = state;
-                            }
-                            None => {
-                                exhausted = true;
-                                continue;
-                            }
-                        }
-                        continue;
-                    }
+                let over_steiner = facet_points.len() + more.len() > opts.max_steiner;
+                // Restarts may cost far more than the first attempt when the polygons'
+                // vertices are wildly off their planes: bound that work too.
+                let over_work = stats.restarts > MAX_RESTARTS
+                    || facet_points.len() + more.len() + presplits.len() + splits.len()
+                        > max_facet_points(plc)
+                    || stats.crossing_tests > RESTART_WORK + 8 * first_work;
+                if (over_steiner || over_work) && retry.is_some() {
+                    retry_failed = true;
+                    continue;
                 }
-                if facet_points.len() + more.len() > opts.max_steiner {
+                if over_steiner {
                     return Err(MeshError::Failed(format!(
                         "polygons that are not flat need more than {} Steiner points (the -S limit)",
                         opts.max_steiner
                     ))
                     .into());
                 }
-                // Restarts may cost far more than the first attempt when the polygons'
-                // vertices are wildly off their planes: bound that work too.
-                if stats.restarts > MAX_RESTARTS
-                    || facet_points.len() + more.len() + presplits.len() + splits.len()
-                        > max_facet_points(plc)
-                    || stats.crossing_tests > RESTART_WORK + 8 * first_work
-                {
+                if over_work {
                     return Err(MeshError::Failed(format!(
                         "polygons that are not flat still conflict after {} Steiner points on them",
                         facet_points.len()

@@ -7,7 +7,7 @@
 //! removes the tet from the CDT instead.
 
 use super::cdt::Cdt;
-use super::prepare::PreparedPlc;
+use super::prepare::{newell_normal, PreparedPlc};
 use crate::carve::{carve, containing_tet_near, Carved};
 use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, dot, sub, Point};
@@ -179,19 +179,11 @@ impl Search<'_> {
 
     /// The area of merged facet `fi` projected on `normal`.
     fn facet_area(&self, fi: usize, normal: &Point) -> f64 {
-        let mut total = 0.0;
-        for ring in &self.prep.facets[fi].rings {
-            let mut n = [0.0; 3];
-            for (k, &a) in ring.iter().enumerate() {
-                let b = ring[(k + 1) % ring.len()];
-                let (pa, pb) = (self.input[a as usize], self.input[b as usize]);
-                n[0] += (pa[1] - pb[1]) * (pa[2] + pb[2]);
-                n[1] += (pa[2] - pb[2]) * (pa[0] + pb[0]);
-                n[2] += (pa[0] - pb[0]) * (pa[1] + pb[1]);
-            }
-            total += 0.5 * dot(&n, normal).abs();
-        }
-        total
+        self.prep.facets[fi]
+            .rings
+            .iter()
+            .map(|ring| 0.5 * dot(&newell_normal(self.input, ring), normal).abs())
+            .sum()
     }
 
     /// Whether some tet around vertex `v` has all four vertices on one facet.
