@@ -170,20 +170,6 @@ pub(super) fn flip(
     faces: bool,
     mut on_face: impl FnMut([VertexId; 3]),
 ) -> Result<Few<TetId>, MeshError> {
-    if sh.kind == Kind::T44 {
-        return replace(mesh, &sh.old, &sh.new, |key| {
-            if faces {
-                on_face(key)
-            }
-        });
-    }
-    if faces {
-        for &t in sh.old.iter() {
-            for j in 0..4 {
-                on_face(face_key(mesh.face_verts(t, j)));
-            }
-        }
-    }
     let (t1, i) = (sh.at.tet(), sh.at.face());
     let t2 = sh.old[1];
     // `pos(t, x)`: the face of `t` opposite its vertex `x`.
@@ -224,10 +210,20 @@ pub(super) fn flip(
                 outer[a][3] = Some(mesh.adj(FaceRef::new(t2, pos(mesh, t2, gone)?)));
             }
         }
-        // Handled above.
-        Kind::T44 => return replace(mesh, &sh.old, &sh.new, |_| {}),
+        Kind::T44 => {
+            return replace(mesh, &sh.old, &sh.new, |key| {
+                if faces {
+                    on_face(key)
+                }
+            })
+        }
     }
     for &t in sh.old.iter() {
+        if faces {
+            for j in 0..4 {
+                on_face(face_key(mesh.face_verts(t, j)));
+            }
+        }
         mesh.kill_tet(t);
     }
     let mut made = Few::of(&[]);

@@ -338,9 +338,23 @@ impl Marks {
         self.members.contains(&v).then(|| self.vert[v as usize])
     }
 
-    fn set_side(&mut self, v: VertexId, side: i8, h: Approx) {
+    /// The side of vertex `v` at `p`, marked now if it was not: 0 on the polygon
+    /// (`on_polygon`, asked only then), else the side of the lifting plane, with its
+    /// height.
+    fn mark(
+        &mut self,
+        v: VertexId,
+        p: &Point,
+        on_polygon: impl FnOnce() -> bool,
+        lift: &Lifting,
+    ) -> i8 {
+        if let Some((s, _)) = self.side(v) {
+            return s;
+        }
+        let s = if on_polygon() { 0 } else { lift.side(p) as i8 };
         self.members.insert(v);
-        self.vert[v as usize] = (side, h);
+        self.vert[v as usize] = (s, lift.height_approx(p, s == 1));
+        s
     }
 }
 
@@ -466,15 +480,8 @@ impl<'a> Flipper<'a> {
         for &t in crossing {
             in_r.insert(t);
             for v in cdt.dt.mesh.verts(t) {
-                if marks.side(v).is_none() {
-                    let p = &cdt.dt.points[v as usize];
-                    let s = if region.verts.contains(&v) {
-                        0
-                    } else {
-                        lift.side(p) as i8
-                    };
-                    marks.set_side(v, s, lift.height_approx(p, s == 1));
-                }
+                let p = &cdt.dt.points[v as usize];
+                marks.mark(v, p, || region.verts.contains(&v), &lift);
             }
         }
         Flipper {
@@ -670,18 +677,10 @@ impl<'a> Flipper<'a> {
         if v == GHOST {
             return 0;
         }
-        if let Some((s, _)) = self.marks.side(v) {
-            return s;
-        }
         let p = &self.cdt.dt.points[v as usize];
-        let s = if self.region.verts.contains(&v) {
-            0
-        } else {
-            self.lift.side(p) as i8
-        };
+        let region = self.region;
         self.marks
-            .set_side(v, s, self.lift.height_approx(p, s == 1));
-        s
+            .mark(v, p, || region.verts.contains(&v), &self.lift)
     }
 
     /// Is tet `t` in R?

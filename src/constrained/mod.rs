@@ -315,17 +315,12 @@ pub fn mesh_plc_with_progress(
     let mut retry_failed = false;
     let built = loop {
         if std::mem::take(&mut retry_failed) {
-            if let Some(r) = retry.as_mut() {
-                match r.next(&stats0) {
-                    Some(state) => (facet_points, presplits, stats, first_work) = state,
-                    None => {
-                        if let Some(r) = retry.take() {
-                            let (b, st, fp) = r.fallback;
-                            (stats, facet_points) = (st, fp);
-                            break b;
-                        }
-                    }
-                }
+            if let Some(state) = retry.as_mut().and_then(|r| r.next(&stats0)) {
+                (facet_points, presplits, stats, first_work) = state;
+            } else if let Some(r) = retry.take() {
+                let (b, st, fp) = r.fallback;
+                (stats, facet_points) = (st, fp);
+                break b;
             }
         }
         opts.check_cancel()?;

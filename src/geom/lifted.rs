@@ -417,8 +417,8 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         return 0;
     }
     counts.exact += 1;
-    let (ia, ja) = (&a.exact(lift).i, &a.exact(lift).j);
-    let (ib, jb) = (&b.exact(lift).i, &b.exact(lift).j);
+    let (ea, eb) = (a.exact(lift), b.exact(lift));
+    let (ia, ja, ib, jb) = (&ea.i, &ea.j, &eb.i, &eb.j);
     let s = ib.mul(ja).sub(&ia.mul(jb)).sign();
     if s != 0 {
         return s;
