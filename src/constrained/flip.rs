@@ -153,7 +153,15 @@ impl Entry {
         self.e & FORCED != 0
     }
 
+    /// A forced event's interval is `[−∞, −∞]`: it comes before every event with a
+    /// finite lower end by the intervals alone, and ties only with forced events and
+    /// those whose interval is everything, which [`Flipper::earlier_tied`] orders.
     fn new(lo: f64, hi: f64, e: u32, forced: bool, group: u32) -> Self {
+        let (lo, hi) = if forced {
+            (f64::NEG_INFINITY, f64::NEG_INFINITY)
+        } else {
+            (lo, hi)
+        };
         Entry {
             lo,
             hi,
@@ -852,13 +860,21 @@ impl<'a> Flipper<'a> {
         let mut k = 0;
         loop {
             let l = 2 * k + 1;
-            if l >= n {
+            if l + 1 >= n {
+                if l < n {
+                    self.heap[k] = self.heap[l];
+                    k = l;
+                }
                 break;
             }
-            let m = if l + 1 < n && self.earlier(self.heap[l + 1], self.heap[l]) {
-                l + 1
+            // The intervals settle nearly every choice; only overlapping ones take the
+            // out-of-line tie-break.
+            let (x, y) = (self.heap[l], self.heap[l + 1]);
+            let right = y.hi < x.lo;
+            let m = if right || x.hi < y.lo {
+                l + right as usize
             } else {
-                l
+                l + self.earlier_tied(y, x) as usize
             };
             self.heap[k] = self.heap[m];
             k = m;
@@ -871,6 +887,18 @@ impl<'a> Flipper<'a> {
     /// Does heap entry `a` come strictly before heap entry `b`?
     #[inline]
     fn earlier(&mut self, a: Entry, b: Entry) -> bool {
+        if a.hi < b.lo {
+            return true;
+        }
+        if b.hi < a.lo {
+            return false;
+        }
+        self.earlier_tied(a, b)
+    }
+
+    /// [`Flipper::earlier`] for entries whose intervals overlap.
+    #[inline(never)]
+    fn earlier_tied(&mut self, a: Entry, b: Entry) -> bool {
         if a.forced() || b.forced() {
             return if a.forced() == b.forced() {
                 a.event() < b.event()
@@ -878,16 +906,7 @@ impl<'a> Flipper<'a> {
                 a.forced()
             };
         }
-        if a.hi < b.lo {
-            self.cmp.filtered += 1;
-            return true;
-        }
-        if b.hi < a.lo {
-            self.cmp.filtered += 1;
-            return false;
-        }
         if a.group == b.group && a.group != 0 {
-            self.cmp.filtered += 1;
             return a.event() < b.event();
         }
         self.earlier_close(a.event(), b.event())
@@ -903,7 +922,6 @@ impl<'a> Flipper<'a> {
             self.events[b as usize].five(),
         );
         if fa == fb {
-            self.cmp.filtered += 1;
             return a < b;
         }
         let (va, vb) = (self.events[a as usize].verts, self.events[b as usize].verts);

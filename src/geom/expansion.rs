@@ -80,12 +80,37 @@ impl Expansion {
         Expansion(self.0.iter().map(|x| -x).collect())
     }
 
-    /// `self + b` for one double (Shewchuk's grow-expansion, eliminating zeros).
-    fn grow_into(e: &[f64], b: f64, out: &mut Vec<f64>) {
-        out.clear();
-        let mut q = b;
-        for &x in e {
-            let (s, h) = two_sum(q, x);
+    /// `e + f` (`e − f` if `negate`): the components of both merged by increasing
+    /// magnitude, then summed from the smallest with exact two-sums, each roundoff left
+    /// behind as a component (Shewchuk's fast expansion sum, zeros eliminated). Linear
+    /// in the lengths, where adding one component at a time was quadratic.
+    fn sum(e: &[f64], f: &[f64], negate: bool) -> Expansion {
+        let sf = if negate { -1.0 } else { 1.0 };
+        let mut out = Vec::with_capacity(e.len() + f.len());
+        let (mut i, mut j) = (0, 0);
+        let mut next = || -> Option<f64> {
+            let g = match (e.get(i), f.get(j)) {
+                (Some(&x), Some(&y)) if x.abs() <= y.abs() => {
+                    i += 1;
+                    x
+                }
+                (_, Some(&y)) => {
+                    j += 1;
+                    sf * y
+                }
+                (Some(&x), None) => {
+                    i += 1;
+                    x
+                }
+                (None, None) => return None,
+            };
+            Some(g)
+        };
+        let Some(mut q) = next() else {
+            return Expansion(out);
+        };
+        while let Some(g) = next() {
+            let (s, h) = two_sum(q, g);
             if h != 0.0 {
                 out.push(h);
             }
@@ -94,27 +119,17 @@ impl Expansion {
         if q != 0.0 {
             out.push(q);
         }
+        Expansion(out)
     }
 
     /// `self + other`.
     pub fn add(&self, other: &Expansion) -> Expansion {
-        let (small, big) = if self.0.len() < other.0.len() {
-            (self, other)
-        } else {
-            (other, self)
-        };
-        let mut acc = big.0.clone();
-        let mut tmp = Vec::with_capacity(acc.len() + small.0.len());
-        for &x in &small.0 {
-            Self::grow_into(&acc, x, &mut tmp);
-            std::mem::swap(&mut acc, &mut tmp);
-        }
-        Expansion(acc)
+        Self::sum(&self.0, &other.0, false)
     }
 
     /// `self - other`.
     pub fn sub(&self, other: &Expansion) -> Expansion {
-        self.add(&other.neg())
+        Self::sum(&self.0, &other.0, true)
     }
 
     /// `self * b` for one double (Shewchuk's scale-expansion, eliminating zeros).
@@ -181,5 +196,66 @@ mod tests {
         assert_eq!(y.estimate(), 2f64.powi(-120));
         assert_eq!(Expansion::diff(0.1, 0.1).sign(), 0);
         assert_eq!(Expansion::diff(0.1, 0.3).neg().sign(), 1);
+    }
+
+    /// The exact value of an expansion whose components are integer multiples of
+    /// 2^-40 below 2^40 in magnitude, as an integer count of 2^-40 (fits in i128).
+    fn fixed(e: &Expansion) -> i128 {
+        e.components()
+            .iter()
+            .map(|&c| {
+                let n = c * 2f64.powi(40);
+                assert_eq!(n.fract(), 0.0, "component {c} off the 2^-40 grid");
+                n as i128
+            })
+            .sum()
+    }
+
+    /// Components strictly increasing in magnitude, nonzero, and each smaller than the
+    /// next one's unit in the last place: what `sign` relies on.
+    fn nonoverlapping(e: &Expansion) -> bool {
+        e.components().windows(2).all(|w| {
+            let (a, b) = (w[0].abs(), w[1].abs());
+            a != 0.0 && a < b && a <= 2f64.powi(b.log2().floor() as i32 - 52)
+        }) && e.components().iter().all(|&c| c != 0.0)
+    }
+
+    #[test]
+    fn merged_sums_and_products_match_integer_arithmetic() {
+        let mut seed = 7u64;
+        // Dyadic numbers of mixed scales, so that components cancel and interleave.
+        let num = |seed: &mut u64| {
+            let m = (crate::geom::lcg(seed) * 2f64.powi(20)).floor();
+            let e = (crate::geom::lcg(seed) * 30.0).floor() as i32 - 20;
+            let s = if crate::geom::lcg(seed) < 0.5 {
+                -1.0
+            } else {
+                1.0
+            };
+            s * m * 2f64.powi(e)
+        };
+        for _ in 0..2000 {
+            let (a, b, c, d) = (
+                num(&mut seed),
+                num(&mut seed),
+                num(&mut seed),
+                num(&mut seed),
+            );
+            let x = Expansion::diff(a, b).add(&Expansion::from_f64(c));
+            let y = Expansion::diff(c, d).sub(&Expansion::diff(a, d));
+            let (fx, fy) = (fixed(&x), fixed(&y));
+            for (e, want) in [(x.add(&y), fx + fy), (x.sub(&y), fx - fy), (y.sub(&y), 0)] {
+                assert!(nonoverlapping(&e), "{e:?}");
+                assert_eq!(fixed(&e), want);
+                assert_eq!(e.sign(), want.signum() as i32);
+            }
+            // Products leave the 2^-40 grid: compare at a scale where they stay on it.
+            let k = 2f64.powi(-20);
+            let xs = x.scale(k);
+            let p = xs.mul(&y.scale(k));
+            assert!(nonoverlapping(&p), "{p:?}");
+            assert_eq!(p.sign(), (fx.signum() * fy.signum()) as i32);
+            assert_eq!(p.sub(&y.scale(k).mul(&xs)).sign(), 0);
+        }
     }
 }
