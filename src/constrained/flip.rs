@@ -22,6 +22,7 @@
 use super::bistellar::{self, Few, Kind};
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats, SlotSet};
 use super::cdt::{edge_key, face_key, Cdt};
+use super::flip_queue::{FlipQueue, Interval};
 use crate::error::MeshError;
 use crate::geom::lifted::{cross_sign, Approx, CompareCounts, FlipTime, Lifting};
 use crate::geom::{cross, dot, insphere_sos, sub, Point, Sign};
@@ -93,19 +94,15 @@ enum Refusal {
     NotFlippable,
 }
 
-/// A certified face, in 36 bytes: the face as seen from its first tet, the tet on its
-/// other side, the generations both tets had when it was certified (it stays valid
-/// while they are unchanged and in R), and the certificate's five vertices (the face's
-/// three and the two apices). The flip time itself is only in the heap entry, as an
-/// interval; where that does not settle an order, which is rare, it is computed again
-/// from the five vertices, which never move. Events are written at random slots, so
-/// their size is cache misses.
+/// A certified face, in 24 bytes: the face as seen from its first tet and the
+/// certificate's five vertices (the face's three and the two apices). The flip time
+/// itself is only in the queue entry, as an interval, with what tells whether the event
+/// is stale; where the interval does not settle an order, which is rare, the time is
+/// computed again from the five vertices, which never move. Events are written at
+/// random slots, so their size is cache misses.
 #[derive(Clone, Copy)]
 struct Event {
     face: FaceRef,
-    t2: TetId,
-    g1: u32,
-    g2: u32,
     verts: [VertexId; 5],
 }
 
@@ -119,10 +116,11 @@ impl Event {
     }
 }
 
-/// A queued event: an interval `[lo, hi]` holding its flip time, and its index with a
-/// flag. Nearly all comparisons are settled from the entries alone, without touching
-/// the events; and entries are kept small, since the heap, stale entries included,
-/// should stay in cache (40-byte entries made the flips 15% slower).
+/// A queued event: an interval `[lo, hi]` holding its flip time, its index with a flag,
+/// and its tets with their generations. Nearly all comparisons are settled from the
+/// entries alone, and stale entries (70% of pops) are recognised without touching the
+/// events. (Entries of 40 bytes made a binary heap of all events 15% slower; the
+/// radix queue moves them in sweeps.)
 #[derive(Clone, Copy)]
 struct Entry {
     lo: f64,
@@ -134,6 +132,23 @@ struct Entry {
     /// the faces of one coming flip, whose intervals always overlap, are then ordered
     /// without reading their events, which are cache misses.
     group: u32,
+    /// The face's tets (the event's first, the other across the face) and their
+    /// generations when it was certified.
+    t1: TetId,
+    t2: TetId,
+    g1: u32,
+    g2: u32,
+}
+
+impl Interval for Entry {
+    #[inline]
+    fn lo(&self) -> f64 {
+        self.lo
+    }
+    #[inline]
+    fn hi(&self) -> f64 {
+        self.hi
+    }
 }
 
 /// The most entries [`Flipper::times`] and [`Flipper::orders`] keep.
@@ -156,7 +171,8 @@ impl Entry {
     /// A forced event's interval is `[−∞, −∞]`: it comes before every event with a
     /// finite lower end by the intervals alone, and ties only with forced events and
     /// those whose interval is everything, which [`Flipper::earlier_tied`] orders.
-    fn new(lo: f64, hi: f64, e: u32, forced: bool, group: u32) -> Self {
+    /// `tets`: the face's two tets and their generations now.
+    fn new(lo: f64, hi: f64, e: u32, forced: bool, group: u32, tets: [u32; 4]) -> Self {
         let (lo, hi) = if forced {
             (f64::NEG_INFINITY, f64::NEG_INFINITY)
         } else {
@@ -167,6 +183,10 @@ impl Entry {
             hi,
             e: if forced { e | FORCED } else { e },
             group,
+            t1: tets[0],
+            t2: tets[1],
+            g1: tets[2],
+            g2: tets[3],
         }
     }
 }
@@ -452,9 +472,9 @@ struct Flipper<'a> {
     gens: Gens,
     /// Event slots free for reuse.
     free_events: Vec<u32>,
-    /// The priority queue (a binary heap; most comparisons are settled by the entries'
-    /// intervals alone, without touching the events).
-    heap: Vec<Entry>,
+    /// The priority queue (most comparisons are settled by the entries' intervals
+    /// alone, without touching the events).
+    queue: Option<Box<FlipQueue<Entry>>>,
     /// List L: dequeued flips that could not be done yet.
     deferred: Vec<Entry>,
     /// The event being processed: the current time.
@@ -503,7 +523,7 @@ impl<'a> Flipper<'a> {
             events: Vec::new(),
             gens: Gens::new(cdt_slots),
             free_events: Vec::new(),
-            heap: Vec::new(),
+            queue: Some(Box::new(FlipQueue::new())),
             deferred: Vec::new(),
             current: None,
             counts: FlipCounts::default(),
@@ -535,7 +555,7 @@ impl<'a> Flipper<'a> {
         let mut flips = 0;
         while let Some(entry) = self.pop() {
             let e = entry.event();
-            if !self.valid(e) {
+            if !self.valid(&entry) {
                 self.free_events.push(e);
                 continue;
             }
@@ -596,7 +616,7 @@ impl<'a> Flipper<'a> {
             let mut keep = Vec::new();
             for entry in list {
                 let e = entry.event();
-                if !self.valid(e) {
+                if !self.valid(&entry) {
                     self.free_events.push(e);
                     continue;
                 }
@@ -794,14 +814,7 @@ impl<'a> Flipper<'a> {
 
     /// Queues the flip of face `f`, certified with the five `verts`, due within `[lo, hi]`.
     fn push_event(&mut self, f: FaceRef, verts: [VertexId; 5], (lo, hi): (f64, f64), forced: bool) {
-        let t2 = self.cdt.dt.mesh.adj(f).tet();
-        let e = Event {
-            face: f,
-            t2,
-            g1: self.gens.of(f.tet()),
-            g2: self.gens.of(t2),
-            verts,
-        };
+        let e = Event { face: f, verts };
         let idx = match self.free_events.pop() {
             Some(i) => {
                 self.events[i as usize] = e;
@@ -814,8 +827,10 @@ impl<'a> Flipper<'a> {
         };
         debug_assert!(idx < FORCED);
         let group = if forced { 0 } else { self.group_of(verts) };
-        self.heap.push(Entry::new(lo, hi, idx, forced, group));
-        self.sift_up(self.heap.len() - 1);
+        let t2 = self.cdt.dt.mesh.adj(f).tet();
+        let tets = [f.tet(), t2, self.gens.of(f.tet()), self.gens.of(t2)];
+        let entry = Entry::new(lo, hi, idx, forced, group, tets);
+        self.with_queue(|q, fl| q.push(entry, &mut |a, b| fl.earlier(*a, *b)));
     }
 
     /// The group of an event of five vertices `verts` queued now: that of an event of
@@ -834,57 +849,22 @@ impl<'a> Flipper<'a> {
         next
     }
 
-    fn sift_up(&mut self, mut k: usize) {
-        let x = self.heap[k];
-        while k > 0 {
-            let parent = (k - 1) / 2;
-            if !self.earlier(x, self.heap[parent]) {
-                break;
-            }
-            self.heap[k] = self.heap[parent];
-            k = parent;
-        }
-        self.heap[k] = x;
+    /// Runs `f` on the queue and the rest of the flipper (the queue's order needs it).
+    #[inline]
+    fn with_queue<R>(&mut self, f: impl FnOnce(&mut FlipQueue<Entry>, &mut Self) -> R) -> R {
+        // Boxed, so that taking it out moves a pointer.
+        let mut q = self.queue.take().expect("the queue is in place");
+        let r = f(&mut q, self);
+        self.queue = Some(q);
+        r
     }
 
-    /// Removes the earliest event. The hole at the root goes down along the earlier
-    /// children to a leaf, and the last entry comes up from there: about half the
-    /// comparisons of sifting the last entry down, since it usually belongs low.
+    /// Removes the earliest event.
     fn pop(&mut self) -> Option<Entry> {
-        let top = *self.heap.first()?;
-        let last = self.heap.pop()?;
-        let n = self.heap.len();
-        if n == 0 {
-            return Some(top);
-        }
-        let mut k = 0;
-        loop {
-            let l = 2 * k + 1;
-            if l + 1 >= n {
-                if l < n {
-                    self.heap[k] = self.heap[l];
-                    k = l;
-                }
-                break;
-            }
-            // The intervals settle nearly every choice; only overlapping ones take the
-            // out-of-line tie-break.
-            let (x, y) = (self.heap[l], self.heap[l + 1]);
-            let right = y.hi < x.lo;
-            let m = if right || x.hi < y.lo {
-                l + right as usize
-            } else {
-                l + self.earlier_tied(y, x) as usize
-            };
-            self.heap[k] = self.heap[m];
-            k = m;
-        }
-        self.heap[k] = last;
-        self.sift_up(k);
-        Some(top)
+        self.with_queue(|q, fl| q.pop(&mut |a, b| fl.earlier(*a, *b)))
     }
 
-    /// Does heap entry `a` come strictly before heap entry `b`?
+    /// Does queue entry `a` come strictly before queue entry `b`?
     #[inline]
     fn earlier(&mut self, a: Entry, b: Entry) -> bool {
         if a.hi < b.lo {
@@ -966,13 +946,15 @@ impl<'a> Flipper<'a> {
         }
     }
 
-    /// Are the event's two tets still there, in R, unchanged since it was certified?
-    /// (Then they are still glued at its face.)
+    /// Are the entry's two tets still there, in R, unchanged since it was certified?
+    /// (Then they are still glued at its face.) The generations alone tell: events are
+    /// made only between two tets of R, and a tet leaves R only by a flip, which gives
+    /// its slot a new generation.
     #[inline]
-    fn valid(&self, e: u32) -> bool {
-        let c = &self.events[e as usize];
-        let t1 = c.face.tet();
-        self.in_r(t1) && self.in_r(c.t2) && self.gens.of(t1) == c.g1 && self.gens.of(c.t2) == c.g2
+    fn valid(&self, c: &Entry) -> bool {
+        let ok = self.gens.of(c.t1) == c.g1 && self.gens.of(c.t2) == c.g2;
+        debug_assert!(!ok || (self.in_r(c.t1) && self.in_r(c.t2)));
+        ok
     }
 
     /// Removes face `f` by a 2-3, 3-2 or 4-4 flip, if the tets around it allow one and

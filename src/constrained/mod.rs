@@ -13,6 +13,7 @@ pub mod cdt;
 pub mod enclosure;
 pub mod facet2d;
 pub mod flip;
+mod flip_queue;
 mod free;
 pub mod prepare;
 pub mod segments;

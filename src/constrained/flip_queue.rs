@@ -1,0 +1,284 @@
+//! The priority queue of the flips' events: a radix heap on the lower ends of the
+//! events' time intervals, in front of a small binary heap that orders the events near
+//! the current time exactly.
+//!
+//! Flip times only grow as the flips go on, so a monotone queue fits: an event is filed
+//! by the highest bit in which its key (the interval's lower end, as ordered bits)
+//! differs from the last minimum, which is one append, and events move towards the
+//! front in sweeps over one bucket at a time, which read memory in order. Only the
+//! events whose intervals reach the earliest upper end go into the binary heap, where
+//! the caller's exact comparison orders them; so the queue pops exactly the event that
+//! one binary heap of all events would.
+
+/// An entry with an interval `[lo, hi]` that holds its priority (no NaN).
+pub(super) trait Interval: Copy {
+    /// The interval's lower end.
+    fn lo(&self) -> f64;
+    /// The interval's upper end.
+    fn hi(&self) -> f64;
+}
+
+/// Low bits of the ordered bits dropped from the keys: keys then tell values apart to
+/// about one part in 4,096 (sign, exponent and 12 bits of mantissa), which bounds how
+/// often an entry is refiled; entries closer than that meet in the binary heap.
+const SHIFT: u32 = 40;
+
+/// The order of `x` as an unsigned integer, coarsened (no NaN): `x < y` if
+/// `key(x) < key(y)`.
+#[inline]
+fn key(x: f64) -> u64 {
+    let b = x.to_bits();
+    let ordered = if b >> 63 == 1 { !b } else { b | 1 << 63 };
+    ordered >> SHIFT
+}
+
+/// The bucket of a key whose bits differ from the last minimum's in `diff`.
+#[inline]
+fn bucket(diff: u64) -> usize {
+    64 - diff.leading_zeros() as usize
+}
+
+/// Events far ahead in radix buckets, events near the current time in a binary heap.
+pub(super) struct FlipQueue<T> {
+    /// Ordered by the caller's comparison: every entry whose key is at most `frontier`.
+    front: Vec<T>,
+    /// Bucket `b > 0` holds the keys above `frontier` whose highest bit differing from
+    /// `last` is bit `b − 1`; bucket 0 those equal to `last`.
+    buckets: Vec<Vec<T>>,
+    /// Bit `b` set when bucket `b` is not empty.
+    full: u128,
+    /// The key the buckets are filed against (at most `frontier`).
+    last: u64,
+    /// Every key above it is in the buckets.
+    frontier: u64,
+    /// Entries in the buckets.
+    far: usize,
+}
+
+impl<T: Interval> FlipQueue<T> {
+    /// An empty queue.
+    pub(super) fn new() -> Self {
+        FlipQueue {
+            front: Vec::new(),
+            buckets: (0..65).map(|_| Vec::new()).collect(),
+            full: 0,
+            last: 0,
+            frontier: 0,
+            far: 0,
+        }
+    }
+
+    /// Entries queued.
+    #[cfg(test)]
+    pub(super) fn len(&self) -> usize {
+        self.front.len() + self.far
+    }
+
+    /// Queues `x`; `earlier(a, b)` says whether `a` comes strictly before `b`.
+    pub(super) fn push(&mut self, x: T, earlier: &mut impl FnMut(&T, &T) -> bool) {
+        let k = key(x.lo());
+        if k <= self.frontier {
+            self.front.push(x);
+            self.sift_up(self.front.len() - 1, earlier);
+        } else {
+            self.file(x, k);
+            self.far += 1;
+        }
+    }
+
+    #[inline]
+    fn file(&mut self, x: T, k: u64) {
+        let b = bucket(k ^ self.last);
+        self.buckets[b].push(x);
+        self.full |= 1 << b;
+    }
+
+    /// The smallest key the buckets can hold now.
+    fn far_bound(&self) -> u64 {
+        match self.full.trailing_zeros() {
+            0 => self.last,
+            b => {
+                let s = b - 1;
+                ((self.last >> s) | 1) << s
+            }
+        }
+    }
+
+    /// Removes and returns the earliest entry.
+    pub(super) fn pop(&mut self, earlier: &mut impl FnMut(&T, &T) -> bool) -> Option<T> {
+        loop {
+            match self.front.first() {
+                // Every far entry starts after this one ends: it is the earliest.
+                Some(top) if self.far == 0 || key(top.hi()) < self.far_bound() => {
+                    return self.pop_front(earlier);
+                }
+                None if self.far == 0 => return None,
+                _ => self.pull(earlier),
+            }
+        }
+    }
+
+    /// Moves the far entries with the smallest key to the front.
+    fn pull(&mut self, earlier: &mut impl FnMut(&T, &T) -> bool) {
+        let b = self.full.trailing_zeros() as usize;
+        if b > 0 {
+            // Refile the first full bucket against its smallest key: all of it goes
+            // to lower buckets, its smallest keys to bucket 0.
+            let list = std::mem::take(&mut self.buckets[b]);
+            self.full &= !(1 << b);
+            self.last = list.iter().map(|x| key(x.lo())).min().unwrap_or(self.last);
+            for &x in &list {
+                self.file(x, key(x.lo()));
+            }
+            // Keep the allocation for the bucket's next use.
+            let mut list = list;
+            list.clear();
+            if self.buckets[b].is_empty() {
+                self.buckets[b] = list;
+            }
+        }
+        let list = std::mem::take(&mut self.buckets[0]);
+        self.full &= !1;
+        self.far -= list.len();
+        self.frontier = self.last;
+        for &x in &list {
+            self.front.push(x);
+            self.sift_up(self.front.len() - 1, earlier);
+        }
+        let mut list = list;
+        list.clear();
+        self.buckets[0] = list;
+    }
+
+    fn sift_up(&mut self, mut k: usize, earlier: &mut impl FnMut(&T, &T) -> bool) {
+        let x = self.front[k];
+        while k > 0 {
+            let parent = (k - 1) / 2;
+            if !earlier(&x, &self.front[parent]) {
+                break;
+            }
+            self.front[k] = self.front[parent];
+            k = parent;
+        }
+        self.front[k] = x;
+    }
+
+    /// Removes the root of the binary heap: the hole goes down along the earlier
+    /// children to a leaf, and the last entry comes up from there.
+    fn pop_front(&mut self, earlier: &mut impl FnMut(&T, &T) -> bool) -> Option<T> {
+        let top = *self.front.first()?;
+        let last = self.front.pop()?;
+        let n = self.front.len();
+        if n == 0 {
+            return Some(top);
+        }
+        let mut k = 0;
+        loop {
+            let l = 2 * k + 1;
+            if l >= n {
+                break;
+            }
+            let m = if l + 1 < n && earlier(&self.front[l + 1], &self.front[l]) {
+                l + 1
+            } else {
+                l
+            };
+            self.front[k] = self.front[m];
+            k = m;
+        }
+        self.front[k] = last;
+        self.sift_up(k, earlier);
+        Some(top)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::lcg;
+
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    struct E {
+        lo: f64,
+        hi: f64,
+        /// The exact priority (inside the interval), then the id breaks ties.
+        t: f64,
+        id: u32,
+    }
+
+    impl Interval for E {
+        fn lo(&self) -> f64 {
+            self.lo
+        }
+        fn hi(&self) -> f64 {
+            self.hi
+        }
+    }
+
+    fn before(a: &E, b: &E) -> bool {
+        (a.t, a.id) < (b.t, b.id)
+    }
+
+    #[test]
+    fn pops_in_the_exact_order_of_one_binary_heap() {
+        let mut seed = 3u64;
+        for round in 0..200 {
+            let mut q = FlipQueue::new();
+            let mut live: Vec<E> = Vec::new();
+            let mut now = if round % 2 == 0 { 0.0 } else { -5.0 };
+            let mut id = 0;
+            let mut popped = 0;
+            for step in 0..400 {
+                // Pushes at or after the current time (a few before it, and some with
+                // wide or unbounded intervals, as the flips' queue gets them).
+                let pushes = (lcg(&mut seed) * 4.0) as usize;
+                for _ in 0..pushes {
+                    let r = lcg(&mut seed);
+                    let t = if r < 0.05 {
+                        now // a tie with the current time
+                    } else if r < 0.1 {
+                        now - lcg(&mut seed) // behind the current time
+                    } else {
+                        now + lcg(&mut seed).powi(3) * 10.0
+                    };
+                    let w = match (lcg(&mut seed) * 10.0) as u32 {
+                        0 => f64::INFINITY,
+                        1 => 0.5,
+                        _ => t.abs() * 1e-14,
+                    };
+                    let (lo, hi) = if w.is_infinite() {
+                        (f64::NEG_INFINITY, f64::INFINITY)
+                    } else {
+                        (t - w * lcg(&mut seed), t + w * lcg(&mut seed))
+                    };
+                    let e = E { lo, hi, t, id };
+                    id += 1;
+                    q.push(e, &mut before);
+                    live.push(e);
+                }
+                if step % 3 != 0 || live.is_empty() {
+                    continue;
+                }
+                let want = *live
+                    .iter()
+                    .min_by(|a, b| (a.t, a.id).partial_cmp(&(b.t, b.id)).unwrap())
+                    .unwrap();
+                let got = q.pop(&mut before).unwrap();
+                assert_eq!(got, want, "round {round}, pop {popped}");
+                live.retain(|e| e.id != got.id);
+                now = now.max(got.t);
+                popped += 1;
+                assert_eq!(q.len(), live.len());
+            }
+            while let Some(got) = q.pop(&mut before) {
+                let want = *live
+                    .iter()
+                    .min_by(|a, b| (a.t, a.id).partial_cmp(&(b.t, b.id)).unwrap())
+                    .unwrap();
+                assert_eq!(got, want);
+                live.retain(|e| e.id != got.id);
+            }
+            assert!(live.is_empty());
+        }
+    }
+}
