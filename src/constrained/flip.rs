@@ -804,10 +804,21 @@ impl<'a> Flipper<'a> {
     /// Queues the flip of crossing face `f` if it ever happens.
     fn certify(&mut self, f: FaceRef) {
         let verts = self.certificate_verts(f);
-        let (pts, orig, left, heights) = self.certificate_of(verts);
-        if let Some(interval) =
-            FlipTime::interval_if_flips(&self.lift, &pts, &orig, &left, &heights)
-        {
+        // Points and heights only: the perturbation indices and sides are read only when
+        // the sign of `J` needs exact arithmetic.
+        let zero = Approx { v: 0.0, p: 0.0 };
+        let (mut pts, mut heights) = ([[0.0; 3]; 5], [zero; 5]);
+        for (k, &x) in verts.iter().enumerate() {
+            pts[k] = self.cdt.dt.points[x as usize];
+            if let Some((_, h)) = self.marks.side(x) {
+                heights[k] = h;
+            }
+        }
+        let interval = FlipTime::interval_if_flips(&self.lift, &pts, &heights, || {
+            let (_, orig, left, _) = self.certificate_of(verts);
+            (orig, left)
+        });
+        if let Some(interval) = interval {
             self.push_event(f, verts, interval, false);
         }
     }

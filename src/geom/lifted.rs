@@ -334,12 +334,14 @@ impl FlipTime {
     /// [`FlipTime::if_flips`] followed by [`FlipTime::interval`], without making the
     /// certificate unless `J`'s sign needs exact arithmetic: queueing a face needs only
     /// the interval (a certificate is 200 bytes, copied three times on its way).
+    ///
+    /// `ids_and_left` gives the points' perturbation indices and which are left; it is
+    /// asked only then.
     pub fn interval_if_flips(
         lift: &Lifting,
         pts: &[Point; 5],
-        ids: &[u32; 5],
-        left: &[bool; 5],
         h: &[Approx; 5],
+        ids_and_left: impl FnOnce() -> ([u32; 5], [bool; 5]),
     ) -> Option<(f64, f64)> {
         let d: [[Approx; 3]; 4] = rows(pts);
         let m = minors(&d);
@@ -348,7 +350,8 @@ impl FlipTime {
             Some(s) if s <= 0 => return None,
             Some(_) => {}
             None => {
-                let t = FlipTime::if_flips(lift, *pts, *ids, *left, *h)?;
+                let (ids, left) = ids_and_left();
+                let t = FlipTime::if_flips(lift, *pts, ids, left, *h)?;
                 return Some(t.interval());
             }
         }
