@@ -3,9 +3,11 @@
 //! the current time exactly.
 //!
 //! Flip times only grow as the flips go on, so a monotone queue fits: an event is filed
-//! by the highest bit in which its key (the interval's lower end, as ordered bits)
-//! differs from the last minimum, which is one append, and events move towards the
-//! front in sweeps over one bucket at a time, which read memory in order. Only the
+//! by the highest 4-bit digit in which its key (the interval's lower end, as ordered
+//! bits) differs from the last minimum, and by its value of that digit, which is one
+//! append; events move towards the front in sweeps over one bucket at a time, which
+//! read memory in order, a level down each time: at most 6 times per entry (with digits
+//! of one bit, the textbook radix heap, up to 24, and the flips took 5% longer). Only the
 //! events whose intervals reach the earliest upper end go into the binary heap, where
 //! the caller's exact comparison orders them; so the queue pops exactly the event that
 //! one binary heap of all events would.
@@ -32,18 +34,49 @@ fn key(x: f64) -> u64 {
     ordered >> SHIFT
 }
 
-/// The bucket of a key whose bits differ from the last minimum's in `diff`.
+/// Bits of a key per level of buckets: an entry is refiled at most once per level.
+const DIGIT: u32 = 4;
+/// Levels of buckets: the keys' bits, a digit per level.
+const LEVELS: usize = ((64 - SHIFT) / DIGIT) as usize;
+/// Buckets: one for keys equal to the last minimum, then `2^DIGIT` per level.
+const BUCKETS: usize = 1 + (LEVELS << DIGIT);
+
+/// The bucket of key `k` against the last minimum `last` (`k >= last`): 0 if equal, else
+/// by the highest digit in which they differ and `k`'s value of that digit, so that
+/// buckets in increasing order hold increasing keys.
 #[inline]
-fn bucket(diff: u64) -> usize {
-    64 - diff.leading_zeros() as usize
+fn bucket(k: u64, last: u64) -> usize {
+    let diff = k ^ last;
+    if diff == 0 {
+        return 0;
+    }
+    let level = (63 - diff.leading_zeros()) / DIGIT;
+    let digit = (k >> (level * DIGIT)) & ((1 << DIGIT) - 1);
+    1 + ((level as usize) << DIGIT) + digit as usize
+}
+
+/// The smallest key bucket `b` can hold against the last minimum `last`.
+#[inline]
+fn bucket_floor(b: usize, last: u64) -> u64 {
+    if b == 0 {
+        return last;
+    }
+    let level = ((b - 1) >> DIGIT) as u32;
+    let digit = ((b - 1) & ((1 << DIGIT) - 1)) as u64;
+    let above = (level + 1) * DIGIT;
+    let prefix = if above >= 64 {
+        0
+    } else {
+        (last >> above) << above
+    };
+    prefix | digit << (level * DIGIT)
 }
 
 /// Events far ahead in radix buckets, events near the current time in a binary heap.
 pub(super) struct FlipQueue<T> {
     /// Ordered by the caller's comparison: every entry whose key is at most `frontier`.
     front: Vec<T>,
-    /// Bucket `b > 0` holds the keys above `frontier` whose highest bit differing from
-    /// `last` is bit `b − 1`; bucket 0 those equal to `last`.
+    /// The keys above `frontier`, by [`bucket`] against `last`.
     buckets: Vec<Vec<T>>,
     /// Bit `b` set when bucket `b` is not empty.
     full: u128,
@@ -60,7 +93,7 @@ impl<T: Interval> FlipQueue<T> {
     pub(super) fn new() -> Self {
         FlipQueue {
             front: Vec::new(),
-            buckets: (0..65).map(|_| Vec::new()).collect(),
+            buckets: (0..BUCKETS).map(|_| Vec::new()).collect(),
             full: 0,
             last: 0,
             frontier: 0,
@@ -88,20 +121,14 @@ impl<T: Interval> FlipQueue<T> {
 
     #[inline]
     fn file(&mut self, x: T, k: u64) {
-        let b = bucket(k ^ self.last);
+        let b = bucket(k, self.last);
         self.buckets[b].push(x);
         self.full |= 1 << b;
     }
 
     /// The smallest key the buckets can hold now.
     fn far_bound(&self) -> u64 {
-        match self.full.trailing_zeros() {
-            0 => self.last,
-            b => {
-                let s = b - 1;
-                ((self.last >> s) | 1) << s
-            }
-        }
+        bucket_floor(self.full.trailing_zeros() as usize, self.last)
     }
 
     /// Removes and returns the earliest entry.
