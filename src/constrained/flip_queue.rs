@@ -40,6 +40,8 @@ const DIGIT: u32 = 4;
 const LEVELS: usize = ((64 - SHIFT) / DIGIT) as usize;
 /// Buckets: one for keys equal to the last minimum, then `2^DIGIT` per level.
 const BUCKETS: usize = 1 + (LEVELS << DIGIT);
+// Every bit of a key falls in a level, and every bucket has a bit in the mask.
+const _: () = assert!((64 - SHIFT).is_multiple_of(DIGIT) && BUCKETS <= 128);
 
 /// The bucket of key `k` against the last minimum `last` (`k >= last`): 0 if equal, else
 /// by the highest digit in which they differ and `k`'s value of that digit, so that
