@@ -768,20 +768,38 @@ impl<'a> Flipper<'a> {
     /// points, perturbation indices, which are left, and their heights.
     #[inline(always)]
     fn certificate_of(&self, ids: [VertexId; 5]) -> ([Point; 5], [u32; 5], [bool; 5], [Approx; 5]) {
-        // One plain loop: five `array::map`s cost several times more here, where every
-        // flip certifies about five faces.
+        let (pts, heights) = self.points_and_heights(ids);
+        let (orig, left) = self.ids_and_sides(ids);
+        (pts, orig, left, heights)
+    }
+
+    /// The five vertices' points and heights: all a certificate needs unless the sign
+    /// of its `J` needs exact arithmetic. (One plain loop: five `array::map`s cost
+    /// several times more here, where every flip certifies about five faces.)
+    #[inline(always)]
+    fn points_and_heights(&self, ids: [VertexId; 5]) -> ([Point; 5], [Approx; 5]) {
         let zero = Approx { v: 0.0, p: 0.0 };
-        let (mut pts, mut orig, mut left, mut heights) =
-            ([[0.0; 3]; 5], [0; 5], [false; 5], [zero; 5]);
+        let (mut pts, mut heights) = ([[0.0; 3]; 5], [zero; 5]);
         for (k, &x) in ids.iter().enumerate() {
             pts[k] = self.cdt.dt.points[x as usize];
-            orig[k] = self.cdt.dt.orig[x as usize];
-            if let Some((side, h)) = self.marks.side(x) {
-                left[k] = side == 1;
+            if let Some((_, h)) = self.marks.side(x) {
                 heights[k] = h;
             }
         }
-        (pts, orig, left, heights)
+        (pts, heights)
+    }
+
+    /// The five vertices' perturbation indices and which are left (rarely needed: kept
+    /// out of line, so that the certificates' hot path inlines as before).
+    #[cold]
+    #[inline(never)]
+    fn ids_and_sides(&self, ids: [VertexId; 5]) -> ([u32; 5], [bool; 5]) {
+        let (mut orig, mut left) = ([0; 5], [false; 5]);
+        for (k, &x) in ids.iter().enumerate() {
+            orig[k] = self.cdt.dt.orig[x as usize];
+            left[k] = matches!(self.marks.side(x), Some((1, _)));
+        }
+        (orig, left)
     }
 
     /// The flip certificate of five vertices in certificate order.
@@ -804,20 +822,9 @@ impl<'a> Flipper<'a> {
     /// Queues the flip of crossing face `f` if it ever happens.
     fn certify(&mut self, f: FaceRef) {
         let verts = self.certificate_verts(f);
-        // Points and heights only: the perturbation indices and sides are read only when
-        // the sign of `J` needs exact arithmetic.
-        let zero = Approx { v: 0.0, p: 0.0 };
-        let (mut pts, mut heights) = ([[0.0; 3]; 5], [zero; 5]);
-        for (k, &x) in verts.iter().enumerate() {
-            pts[k] = self.cdt.dt.points[x as usize];
-            if let Some((_, h)) = self.marks.side(x) {
-                heights[k] = h;
-            }
-        }
-        let interval = FlipTime::interval_if_flips(&self.lift, &pts, &heights, || {
-            let (_, orig, left, _) = self.certificate_of(verts);
-            (orig, left)
-        });
+        let (pts, heights) = self.points_and_heights(verts);
+        let interval =
+            FlipTime::interval_if_flips(&self.lift, &pts, &heights, || self.ids_and_sides(verts));
         if let Some(interval) = interval {
             self.push_event(f, verts, interval, false);
         }

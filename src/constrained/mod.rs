@@ -500,7 +500,7 @@ struct Built {
     /// the first.
     flat_left: (usize, Option<u32>),
     /// When a few tets are left on facets: points for another construction that may
-    /// leave none (see [`slivers::retry_points`]).
+    /// leave none (see [`slivers::flat_left`]).
     retry_points: Vec<Point>,
     /// Whether a face around the first earlier point (a retry's own point) lies on a
     /// facet beside its triangles.
@@ -835,18 +835,13 @@ fn attempt(
     if !steiner.is_empty() || !splits.is_empty() {
         return Ok(Attempt::Restart(steiner, splits));
     }
-    let flat_left = match flat_left {
-        Some(known) => known,
-        None => {
+    let (flat_left, retry_points) = match flat_left {
+        // Known, and too many (or none) for other constructions: no search needed.
+        Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.0) => (known, Vec::new()),
+        _ => {
             let search = search.get_or_insert_with(|| make_search(&cdt));
-            slivers::flat_left(&mut cdt, search, &mut carved)
+            slivers::flat_left(&mut cdt, search, &mut carved, MAX_RETRY_TETS)
         }
-    };
-    let retry_points = if (1..=MAX_RETRY_TETS).contains(&flat_left.0) {
-        let search = search.get_or_insert_with(|| make_search(&cdt));
-        slivers::retry_points(&mut cdt, search, &mut carved)
-    } else {
-        Vec::new()
     };
     let first_point_covers = match facet_points.first() {
         Some(&(FREE_POINT, _)) => {

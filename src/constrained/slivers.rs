@@ -290,14 +290,25 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
 }
 
 /// How many tets that carving keeps lie on one facet, and the facet of the first: what
-/// is left once no free point removes any more. `carved` as in [`free_points`].
+/// is left once no free point removes any more; and, when at most `max_retry` are left,
+/// the [`retry_points`] of the first thick one. One search for both. `carved` as in
+/// [`free_points`].
 pub(crate) fn flat_left(
     cdt: &mut Cdt,
     search: &Search<'_>,
     carved: &mut Option<Carved>,
-) -> (usize, Option<u32>) {
-    find_flat(cdt, search, carved)
-        .map_or((0, None), |f| (f.tets.len(), f.tets.first().map(|x| x.1)))
+    max_retry: usize,
+) -> ((usize, Option<u32>), Vec<Point>) {
+    let Some(found) = find_flat(cdt, search, carved) else {
+        return ((0, None), Vec::new());
+    };
+    let left = (found.tets.len(), found.tets.first().map(|x| x.1));
+    let retry = if left.0 <= max_retry {
+        retry_points(cdt, search, &found)
+    } else {
+        Vec::new()
+    };
+    (left, retry)
 }
 
 /// Free vertices that remove the tets lying on one facet, a list for each such tet, and
@@ -351,14 +362,8 @@ pub(crate) fn free_points(
 /// vertices, then through the circumcenter; inside the domain. Such a tet sits where
 /// facets meet at a step, the CDT lets no point into its sphere in place, and which of
 /// these places leaves no tet on any facet only a construction tells.
-pub(crate) fn retry_points(
-    cdt: &mut Cdt,
-    search: &Search<'_>,
-    carved: &mut Option<Carved>,
-) -> Vec<Point> {
-    let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
-        return Vec::new();
-    };
+fn retry_points(cdt: &mut Cdt, search: &Search<'_>, found: &Found) -> Vec<Point> {
+    let Found { tets, kept } = found;
     let Some(&(t, f, _)) = tets.iter().find(|x| !x.2) else {
         return Vec::new();
     };

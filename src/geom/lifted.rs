@@ -336,7 +336,9 @@ impl FlipTime {
     /// the interval (a certificate is 200 bytes, copied three times on its way).
     ///
     /// `ids_and_left` gives the points' perturbation indices and which are left; it is
-    /// asked only then.
+    /// asked only then. Always inlined: as a call from the flips' `certify`, their hottest
+    /// caller, it cost 3% more instructions.
+    #[inline(always)]
     pub fn interval_if_flips(
         lift: &Lifting,
         pts: &[Point; 5],
