@@ -32,25 +32,12 @@ pub fn read(path: &Path) -> Result<Plc, InputError> {
 /// sibling `.node` file when the node section is empty.
 pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
     let mut lines = Lines::new(text, path);
-    let mut plc = read_node_part(&mut lines)?;
-
-    let mut header =
-        lines.expect_line(|| "the facet section header `<#facets> <boundary markers>`".into())?;
-    let nfacets = header.count(|| "the number of facets".into())?;
-    let has_markers = header.opt_flag(|| "the number of facet boundary markers".into())?;
-    let header_line = header.number();
+    let (mut plc, section) = read_to_facets(&mut lines)?;
     let first = plc.first_index;
     let npoints = plc.points.len();
 
-    plc.facets = Vec::with_capacity(lines.capacity_for(nfacets));
-    for f in 0..nfacets {
-        let fnum = first + f;
-        let mut line = lines.expect_line(|| {
-            format!(
-                "facet {fnum} ({} of {nfacets} announced on line {header_line})",
-                f + 1
-            )
-        })?;
+    for f in 0..section.nfacets {
+        let (fnum, mut line) = section.facet_line(&mut lines, f, first)?;
         let npolygons = line.count(|| format!("the number of polygons of facet {fnum}"))?;
         if npolygons == 0 {
             return Err(line.error(format!("facet {fnum} has no polygons")));
@@ -58,12 +45,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
         let nholes = line
             .opt_count(|| format!("the number of holes of facet {fnum}"))?
             .unwrap_or(0);
-        let marker = if has_markers {
-            line.opt_marker(|| format!("the boundary marker of facet {fnum}"))?
-                .unwrap_or(0)
-        } else {
-            0
-        };
+        let marker = section.marker(&mut line, fnum)?;
         let facet_line = line.number();
         let mut facet = Facet {
             polygons: Vec::with_capacity(npolygons.min(16)),
@@ -101,6 +83,64 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
 
     read_holes_and_regions(&mut lines, &mut plc)?;
     Ok(plc)
+}
+
+/// The header of the facet section of a `.poly` or `.smesh` file.
+pub(crate) struct FacetSection {
+    /// The number of facets announced.
+    pub nfacets: usize,
+    has_markers: bool,
+    header_line: usize,
+}
+
+impl FacetSection {
+    /// The line of facet `f` (counted from 0) and its number as the file counts
+    /// (`first` the node numbering's first index).
+    pub(crate) fn facet_line<'a>(
+        &self,
+        lines: &mut Lines<'a>,
+        f: usize,
+        first: usize,
+    ) -> Result<(usize, Line<'a>), InputError> {
+        let fnum = first + f;
+        let line = lines.expect_line(|| {
+            format!(
+                "facet {fnum} ({} of {} announced on line {})",
+                f + 1,
+                self.nfacets,
+                self.header_line
+            )
+        })?;
+        Ok((fnum, line))
+    }
+
+    /// Facet `fnum`'s boundary marker, next on its line when the header says there are
+    /// markers (a missing one counts as 0).
+    pub(crate) fn marker(&self, line: &mut Line<'_>, fnum: usize) -> Result<i32, InputError> {
+        if !self.has_markers {
+            return Ok(0);
+        }
+        Ok(line
+            .opt_marker(|| format!("the boundary marker of facet {fnum}"))?
+            .unwrap_or(0))
+    }
+}
+
+/// Reads a `.poly` or `.smesh` file up to its facets: part 1 (see [`read_node_part`]) and
+/// the facet section's header, with room reserved for the facets.
+pub(crate) fn read_to_facets(lines: &mut Lines<'_>) -> Result<(Plc, FacetSection), InputError> {
+    let mut plc = read_node_part(lines)?;
+    let mut header =
+        lines.expect_line(|| "the facet section header `<#facets> <boundary markers>`".into())?;
+    let nfacets = header.count(|| "the number of facets".into())?;
+    let has_markers = header.opt_flag(|| "the number of facet boundary markers".into())?;
+    plc.facets = Vec::with_capacity(lines.capacity_for(nfacets));
+    let section = FacetSection {
+        nfacets,
+        has_markers,
+        header_line: header.number(),
+    };
+    Ok((plc, section))
 }
 
 /// Reads part 1 of a `.poly` or `.smesh` file: the points, either from the file itself

@@ -6,7 +6,7 @@
 //! may have a point count of 0, meaning the points are in the sibling `.node` file; the
 //! hole and region parts are as in `.poly` (and may be missing at the end of the file).
 
-use super::poly::{read_holes_and_regions, read_node_part, read_polygon, PolygonId};
+use super::poly::{read_holes_and_regions, read_polygon, read_to_facets, PolygonId};
 use super::tokens::{read_text, Lines};
 use crate::error::InputError;
 use crate::plc::{Facet, Plc};
@@ -22,25 +22,12 @@ pub fn read(path: &Path) -> Result<Plc, InputError> {
 /// sibling `.node` file when the node section is empty.
 pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
     let mut lines = Lines::new(text, path);
-    let mut plc = read_node_part(&mut lines)?;
-
-    let mut header =
-        lines.expect_line(|| "the facet section header `<#facets> <boundary markers>`".into())?;
-    let nfacets = header.count(|| "the number of facets".into())?;
-    let has_markers = header.opt_flag(|| "the number of facet boundary markers".into())?;
-    let header_line = header.number();
+    let (mut plc, section) = read_to_facets(&mut lines)?;
     let first = plc.first_index;
     let npoints = plc.points.len();
 
-    plc.facets = Vec::with_capacity(lines.capacity_for(nfacets));
-    for f in 0..nfacets {
-        let fnum = first + f;
-        let mut line = lines.expect_line(|| {
-            format!(
-                "facet {fnum} ({} of {nfacets} announced on line {header_line})",
-                f + 1
-            )
-        })?;
+    for f in 0..section.nfacets {
+        let (fnum, mut line) = section.facet_line(&mut lines, f, first)?;
         let polygon = read_polygon(
             &mut line,
             PolygonId {
@@ -50,12 +37,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Plc, InputError> {
             first,
             npoints,
         )?;
-        let marker = if has_markers {
-            line.opt_marker(|| format!("the boundary marker of facet {fnum}"))?
-                .unwrap_or(0)
-        } else {
-            0
-        };
+        let marker = section.marker(&mut line, fnum)?;
         plc.facets.push(Facet {
             polygons: vec![polygon],
             holes: Vec::new(),
