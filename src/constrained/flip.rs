@@ -128,10 +128,6 @@ struct Entry {
     /// The event's index, with [`FORCED`] set if the face was found not locally
     /// regular now (safeguard 2: such events come first).
     e: u32,
-    /// Events queued together with the same five vertices share a group (0: none):
-    /// the faces of one coming flip, whose intervals always overlap, are then ordered
-    /// without reading their events, which are cache misses.
-    group: u32,
     /// The face's tets (the event's first, the other across the face) and their
     /// generations when it was certified.
     t1: TetId,
@@ -172,7 +168,7 @@ impl Entry {
     /// finite lower end by the intervals alone, and ties only with forced events and
     /// those whose interval is everything, which [`Flipper::earlier_tied`] orders.
     /// `tets`: the face's two tets and their generations now.
-    fn new(lo: f64, hi: f64, e: u32, forced: bool, group: u32, tets: [u32; 4]) -> Self {
+    fn new(lo: f64, hi: f64, e: u32, forced: bool, tets: [u32; 4]) -> Self {
         let (lo, hi) = if forced {
             (f64::NEG_INFINITY, f64::NEG_INFINITY)
         } else {
@@ -182,7 +178,6 @@ impl Entry {
             lo,
             hi,
             e: if forced { e | FORCED } else { e },
-            group,
             t1: tets[0],
             t2: tets[1],
             g1: tets[2],
@@ -190,6 +185,26 @@ impl Entry {
         }
     }
 }
+
+/// A face certified in the same batch as an event of the same five vertices: a face of
+/// the same coming flip, which is not queued (a sixth of all certificates on Figure 9,
+/// each a push and a stale pop). When its event is done with (flipped, stale, or left
+/// in list L at the end), the face goes into the queue after all if its two tets are
+/// still there: a flip of other tets may leave it standing, still due.
+#[derive(Clone, Copy)]
+struct Cover {
+    /// The next cover of the same event ([`NO_COVER`]: none).
+    next: u32,
+    face: FaceRef,
+    verts: [VertexId; 5],
+    lo: f64,
+    hi: f64,
+    /// The face's tets and their generations, as in [`Entry`].
+    tets: [u32; 4],
+}
+
+/// The end of a list of covers.
+const NO_COVER: u32 = u32::MAX;
 
 /// Inserts the region `tris` of facet `facet` by flips; same contract as
 /// [`cavity::insert_region`]. Adds this region's figures to `total`, whatever the outcome.
@@ -491,11 +506,16 @@ struct Flipper<'a> {
     orders: Vec<([VertexId; 5], [VertexId; 5], i32)>,
     /// Subfaces among the faces of deleted tets.
     at_risk: Vec<[VertexId; 3]>,
-    /// The sorted fives and groups of the events queued in this batch (see
-    /// [`Entry::group`]): after one flip, or around one tet at the start.
+    /// The sorted fives of the events queued in this batch (after one flip, or around
+    /// one tet at the start), with their events: another face of the same five is a
+    /// face of the same coming flip, and rides on that event as a [`Cover`].
     batch: Vec<([VertexId; 5], u32)>,
-    /// The last group given.
-    next_group: u32,
+    /// Faces riding on events, in slots linked from [`Flipper::cover_head`].
+    covers: Vec<Cover>,
+    /// Cover slots free for reuse.
+    free_covers: Vec<u32>,
+    /// The first cover of each event ([`NO_COVER`]: none).
+    cover_head: Vec<u32>,
     /// Crossing tets (a left and a right vertex) left when the queue ran dry.
     crossing_left: usize,
 }
@@ -532,7 +552,9 @@ impl<'a> Flipper<'a> {
             orders: Vec::new(),
             at_risk: Vec::new(),
             batch: Vec::new(),
-            next_group: 0,
+            covers: Vec::new(),
+            free_covers: Vec::new(),
+            cover_head: Vec::new(),
             crossing_left: 0,
         }
     }
@@ -553,29 +575,42 @@ impl<'a> Flipper<'a> {
         }
         let budget = 50 * r.len() + 1000;
         let mut flips = 0;
-        while let Some(entry) = self.pop() {
-            let e = entry.event();
-            if !self.valid(&entry) {
-                self.free_events.push(e);
-                continue;
-            }
-            flips += 1;
-            if flips > budget {
-                return Ok(false);
-            }
-            match self.try_flip(self.events[e as usize].face, false)? {
-                Ok(new) => {
-                    if let Some(old) = self.current.replace(e) {
-                        self.free_events.push(old);
+        loop {
+            while let Some(entry) = self.pop() {
+                let e = entry.event();
+                if !self.valid(&entry) {
+                    self.release_covers(e);
+                    self.free_events.push(e);
+                    continue;
+                }
+                flips += 1;
+                if flips > budget {
+                    return Ok(false);
+                }
+                match self.try_flip(self.events[e as usize].face, false)? {
+                    Ok(new) => {
+                        if let Some(old) = self.current.replace(e) {
+                            self.free_events.push(old);
+                        }
+                        self.after_flip(&new, !entry.forced());
+                        self.release_covers(e);
+                        self.retry_deferred()?;
                     }
-                    self.after_flip(&new, !entry.forced());
-                    self.retry_deferred()?;
+                    Err(why) => {
+                        self.count_refusal(why);
+                        self.deferred.push(entry);
+                        self.counts.deferred += 1;
+                    }
                 }
-                Err(why) => {
-                    self.count_refusal(why);
-                    self.deferred.push(entry);
-                    self.counts.deferred += 1;
-                }
+            }
+            // The faces riding on flips still in list L get their own chance.
+            let waiting: Vec<u32> = self.deferred.iter().map(|x| x.event()).collect();
+            let mut any = false;
+            for e in waiting {
+                any |= self.release_covers(e);
+            }
+            if !any {
+                break;
             }
         }
         let tris = self.region.tris.clone();
@@ -617,12 +652,14 @@ impl<'a> Flipper<'a> {
             for entry in list {
                 let e = entry.event();
                 if !self.valid(&entry) {
+                    self.release_covers(e);
                     self.free_events.push(e);
                     continue;
                 }
                 match self.try_flip(self.events[e as usize].face, false)? {
                     Ok(new) => {
                         self.after_flip(&new, !entry.forced());
+                        self.release_covers(e);
                         self.free_events.push(e);
                         progress = true;
                     }
@@ -830,41 +867,86 @@ impl<'a> Flipper<'a> {
         }
     }
 
-    /// Queues the flip of face `f`, certified with the five `verts`, due within `[lo, hi]`.
+    /// Queues the flip of face `f`, certified with the five `verts`, due within `[lo, hi]`;
+    /// or, if an event of the same five was queued in this batch, lets it ride on that
+    /// event (`ride`: not for forced events, nor for covers coming back).
     fn push_event(&mut self, f: FaceRef, verts: [VertexId; 5], (lo, hi): (f64, f64), forced: bool) {
+        self.push_entry(f, verts, (lo, hi), forced, !forced);
+    }
+
+    fn push_entry(
+        &mut self,
+        f: FaceRef,
+        verts: [VertexId; 5],
+        (lo, hi): (f64, f64),
+        forced: bool,
+        ride: bool,
+    ) {
+        let t2 = self.cdt.dt.mesh.adj(f).tet();
+        let tets = [f.tet(), t2, self.gens.of(f.tet()), self.gens.of(t2)];
+        let mut five = verts;
+        if ride {
+            five.sort_unstable();
+            if let Some(&(_, e)) = self.batch.iter().find(|(x, _)| *x == five) {
+                let c = Cover {
+                    next: self.cover_head[e as usize],
+                    face: f,
+                    verts,
+                    lo,
+                    hi,
+                    tets,
+                };
+                let slot = match self.free_covers.pop() {
+                    Some(i) => {
+                        self.covers[i as usize] = c;
+                        i
+                    }
+                    None => {
+                        self.covers.push(c);
+                        (self.covers.len() - 1) as u32
+                    }
+                };
+                self.cover_head[e as usize] = slot;
+                return;
+            }
+        }
         let e = Event { face: f, verts };
         let idx = match self.free_events.pop() {
             Some(i) => {
                 self.events[i as usize] = e;
+                self.cover_head[i as usize] = NO_COVER;
                 i
             }
             None => {
                 self.events.push(e);
+                self.cover_head.push(NO_COVER);
                 (self.events.len() - 1) as u32
             }
         };
         debug_assert!(idx < FORCED);
-        let group = if forced { 0 } else { self.group_of(verts) };
-        let t2 = self.cdt.dt.mesh.adj(f).tet();
-        let tets = [f.tet(), t2, self.gens.of(f.tet()), self.gens.of(t2)];
-        let entry = Entry::new(lo, hi, idx, forced, group, tets);
+        if ride {
+            self.batch.push((five, idx));
+        }
+        let entry = Entry::new(lo, hi, idx, forced, tets);
         self.with_queue(|q, fl| q.push(entry, &mut |a, b| fl.earlier(*a, *b)));
     }
 
-    /// The group of an event of five vertices `verts` queued now: that of an event of
-    /// the same five queued since the batch began, else a new one.
-    fn group_of(&mut self, verts: [VertexId; 5]) -> u32 {
-        let mut five = verts;
-        five.sort_unstable();
-        if let Some(&(_, g)) = self.batch.iter().find(|(f, _)| *f == five) {
-            return g;
+    /// Done with event `e`: the faces riding on it whose tets are all still there go
+    /// into the queue. True if any did.
+    fn release_covers(&mut self, e: u32) -> bool {
+        let mut c = std::mem::replace(&mut self.cover_head[e as usize], NO_COVER);
+        let mut any = false;
+        while c != NO_COVER {
+            let cv = self.covers[c as usize];
+            self.free_covers.push(c);
+            c = cv.next;
+            let [t1, t2, g1, g2] = cv.tets;
+            if self.gens.of(t1) == g1 && self.gens.of(t2) == g2 {
+                self.push_entry(cv.face, cv.verts, (cv.lo, cv.hi), false, false);
+                any = true;
+            }
         }
-        let Some(next) = self.next_group.checked_add(1) else {
-            return 0;
-        };
-        self.next_group = next;
-        self.batch.push((five, next));
-        next
+        any
     }
 
     /// Runs `f` on the queue and the rest of the flipper (the queue's order needs it).
@@ -903,9 +985,6 @@ impl<'a> Flipper<'a> {
             } else {
                 a.forced()
             };
-        }
-        if a.group == b.group && a.group != 0 {
-            return a.event() < b.event();
         }
         self.earlier_close(a.event(), b.event())
     }
