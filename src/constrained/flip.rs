@@ -206,6 +206,20 @@ struct Cover {
 /// The end of a list of covers.
 const NO_COVER: u32 = u32::MAX;
 
+/// Stores `x` in a free slot of `slots` (from `free`) or a new one; its index.
+fn put<T>(slots: &mut Vec<T>, free: &mut Vec<u32>, x: T) -> u32 {
+    match free.pop() {
+        Some(i) => {
+            slots[i as usize] = x;
+            i
+        }
+        None => {
+            slots.push(x);
+            (slots.len() - 1) as u32
+        }
+    }
+}
+
 /// Inserts the region `tris` of facet `facet` by flips; same contract as
 /// [`cavity::insert_region`]. Adds this region's figures to `total`, whatever the outcome.
 pub fn insert_region(
@@ -874,6 +888,7 @@ impl<'a> Flipper<'a> {
         self.push_entry(f, verts, (lo, hi), forced, !forced);
     }
 
+    /// [`Flipper::push_event`], with riding allowed or not.
     fn push_entry(
         &mut self,
         f: FaceRef,
@@ -896,33 +911,17 @@ impl<'a> Flipper<'a> {
                     hi,
                     tets,
                 };
-                let slot = match self.free_covers.pop() {
-                    Some(i) => {
-                        self.covers[i as usize] = c;
-                        i
-                    }
-                    None => {
-                        self.covers.push(c);
-                        (self.covers.len() - 1) as u32
-                    }
-                };
-                self.cover_head[e as usize] = slot;
+                self.cover_head[e as usize] = put(&mut self.covers, &mut self.free_covers, c);
                 return;
             }
         }
-        let e = Event { face: f, verts };
-        let idx = match self.free_events.pop() {
-            Some(i) => {
-                self.events[i as usize] = e;
-                self.cover_head[i as usize] = NO_COVER;
-                i
-            }
-            None => {
-                self.events.push(e);
-                self.cover_head.push(NO_COVER);
-                (self.events.len() - 1) as u32
-            }
-        };
+        let idx = put(
+            &mut self.events,
+            &mut self.free_events,
+            Event { face: f, verts },
+        );
+        self.cover_head.resize(self.events.len(), NO_COVER);
+        self.cover_head[idx as usize] = NO_COVER;
         debug_assert!(idx < FORCED);
         if ride {
             self.batch.push((five, idx));
