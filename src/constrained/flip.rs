@@ -22,7 +22,7 @@
 use super::bistellar::{self, Few, Kind};
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats, SlotSet};
 use super::cdt::{edge_key, face_key, Cdt};
-use super::flip_queue::{FlipQueue, Interval};
+use super::flip_queue::{FlipQueue, Interval, Order};
 use crate::error::MeshError;
 use crate::geom::lifted::{cross_sign, Approx, CompareCounts, FlipTime, Lifting};
 use crate::geom::{cross, dot, insphere_sos, sub, Point, Sign};
@@ -205,6 +205,26 @@ struct Cover {
 
 /// The end of a list of covers.
 const NO_COVER: u32 = u32::MAX;
+
+impl Order<Entry> for Flipper<'_> {
+    #[inline]
+    fn earlier(&mut self, a: &Entry, b: &Entry) -> bool {
+        Flipper::earlier(self, *a, *b)
+    }
+
+    /// A stale entry with no faces riding on it is dropped on its way to the front (most
+    /// pops were stale): its event's slot is free at once. One with riders stays, to
+    /// release them when popped.
+    #[inline]
+    fn keep(&mut self, x: &Entry) -> bool {
+        let e = x.event();
+        if self.valid(x) || self.cover_head[e as usize] != NO_COVER {
+            return true;
+        }
+        self.free_events.push(e);
+        false
+    }
+}
 
 /// Stores `x` in a free slot of `slots` (from `free`) or a new one; its index.
 fn put<T>(slots: &mut Vec<T>, free: &mut Vec<u32>, x: T) -> u32 {
@@ -927,7 +947,7 @@ impl<'a> Flipper<'a> {
             self.batch.push((five, idx));
         }
         let entry = Entry::new(lo, hi, idx, forced, tets);
-        self.with_queue(|q, fl| q.push(entry, &mut |a, b| fl.earlier(*a, *b)));
+        self.with_queue(|q, fl| q.push(entry, fl));
     }
 
     /// Done with event `e`: the faces riding on it whose tets are all still there go
@@ -960,7 +980,7 @@ impl<'a> Flipper<'a> {
 
     /// Removes the earliest event.
     fn pop(&mut self) -> Option<Entry> {
-        self.with_queue(|q, fl| q.pop(&mut |a, b| fl.earlier(*a, *b)))
+        self.with_queue(|q, fl| q.pop(fl))
     }
 
     /// Does queue entry `a` come strictly before queue entry `b`?
