@@ -10,7 +10,8 @@
 //! of one bit, the textbook radix heap, up to 24, and the flips took 5% longer). Only the
 //! events whose intervals reach the earliest upper end go into the binary heap, where
 //! the caller's exact comparison orders them; so the queue pops exactly the event that
-//! one binary heap of all events would.
+//! one binary heap of all events would. On each sweep the caller may drop entries that
+//! no longer matter (events made stale by a flip), which then cost no more moves.
 
 /// An entry with an interval `[lo, hi]` that holds its priority (no NaN).
 pub(super) trait Interval: Copy {
