@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""What the shims that validate_mesh.py counts in a mesh are made of.
+
+usage: scripts/shim-report.py INPUT OUT_PREFIX [--list] [--tools DIR]
+
+The referee (../shared/tools/validate_mesh.py, imported from DIR, by default the first
+of ../shared/tools and /work/shared/tools that has it) merges edge-adjacent polygons
+within 0.1 degrees, and counts a flat tet as a shim when its four vertices all lie on
+one merged group: the group's own input vertices, or Steiner points inside the group's
+bounding box and within its slab (four times the group's deviation from its plane).
+This script finds the same shims and sorts each vertex into one of three kinds:
+
+  I  an input vertex of the group;
+  S  a Steiner point on one of the group's own edges;
+  F  a "foreign" Steiner point: on no edge of the group, but inside its slab.
+
+It prints how many shims there are of each composition, then the heights of the
+foreign vertices above the group's plane as fractions of the slab's half-thickness.
+With --list it also prints every shim. The README's figures on attene_cdt/112544.off
+come from this script. It needs numpy.
+"""
+import os
+import sys
+
+import numpy as np
+
+
+def load_referee(argv):
+    here = os.path.dirname(os.path.abspath(__file__))
+    dirs = [os.path.join(here, "..", "..", "shared", "tools"), "/work/shared/tools"]
+    if "--tools" in argv:
+        dirs.insert(0, argv[argv.index("--tools") + 1])
+    for d in dirs:
+        if os.path.isfile(os.path.join(d, "validate_mesh.py")):
+            sys.path.insert(0, d)
+            import validate_mesh
+
+            return validate_mesh
+    sys.exit("shim-report.py: validate_mesh.py not found (use --tools DIR)")
+
+
+def read_input(vm, path):
+    ext = path.rsplit(".", 1)[-1].lower()
+    readers = {
+        "poly": lambda p: vm.read_poly(p),
+        "smesh": lambda p: vm.read_poly(p, smesh=True),
+        "off": vm.read_off,
+        "mesh": vm.read_medit,
+    }
+    if ext not in readers:
+        sys.exit(f"shim-report.py: unsupported input {path}")
+    pts, _raw, polys, facet_of, _holes = readers[ext](path)
+    return pts, polys, facet_of
+
+
+def main(argv):
+    vm = load_referee(argv)
+    args, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == "--tools":
+            skip = True
+        elif not a.startswith("--"):
+            args.append(a)
+    if len(args) != 2:
+        sys.exit(__doc__)
+    inp, prefix = args
+    ipts, polys, facet_of = read_input(vm, inp)
+    P, _raw, base, _ = vm.read_node(prefix + ".node")
+    T = vm.read_ele(prefix + ".ele", base)
+    where = {}
+    for i, q in enumerate(map(tuple, P.tolist())):
+        where.setdefault(q, i)
+    to_out = np.array([where.get(tuple(q), -1) for q in ipts.tolist()])
+    kept = {int(x) for x in to_out if x >= 0}
+    polys = [vm.dedup_ring([int(to_out[v]) for v in poly]) for poly in polys]
+    _s, det = vm.orient3d_signs(P, T[:, 0], T[:, 1], T[:, 2], T[:, 3])
+    diag = float(np.linalg.norm(P.max(0) - P.min(0))) or 1.0
+    steiner = np.array(sorted(set(range(len(P))) - kept), dtype=np.int64)
+    tets_of_vertex = {}
+    for t, tv in enumerate(T.tolist()):
+        for v in tv:
+            tets_of_vertex.setdefault(v, []).append(t)
+    groups, _edges = vm.merge_coplanar(P, polys, facet_of)
+
+    def on_edge(v, a, b):
+        d = P[b] - P[a]
+        length = np.linalg.norm(d)
+        t = (P[v] - P[a]) @ d / length**2
+        return 0 < t < 1 and np.linalg.norm(np.cross(P[v] - P[a], d)) / length < 1e-9 * diag
+
+    kinds, heights, total = {}, [], 0
+    for gi, group in enumerate(groups):
+        gpolys = [polys[i] for i in group if len(polys[i]) >= 3]
+        if not gpolys:
+            continue
+        # The referee's slab and box for this group, computed as it computes them.
+        normals = [vm.newell_normal(P[q]) for q in gpolys]
+        nrm = normals[int(np.argmax([np.linalg.norm(n) for n in normals]))]
+        nrm = nrm / np.linalg.norm(nrm)
+        own = sorted({v for q in gpolys for v in q})
+        Q = P[own]
+        mean = Q.mean(0)
+        tol = max(1e-10 * diag, 4 * np.abs((Q - mean) @ nrm).max())
+        lo, hi = Q.min(0) - tol, Q.max(0) + tol
+        S = P[steiner]
+        near = np.all((S >= lo) & (S <= hi), axis=1) & (np.abs((S - mean) @ nrm) <= tol)
+        verts = set(own) | set(steiner[near].tolist())
+        edges = {(min(q[k], q[(k + 1) % len(q)]), max(q[k], q[(k + 1) % len(q)]))
+                 for q in gpolys for k in range(len(q))}
+        for v in verts:
+            for t in tets_of_vertex.get(v, ()):
+                tv = [int(x) for x in T[t]]
+                if min(tv) != v or not all(x in verts for x in tv):
+                    continue
+                longest = max(np.linalg.norm(P[tv[i]] - P[tv[j]]) for i in range(4) for j in range(i + 1, 4))
+                if abs(det[t]) / 6.0 > 1e-3 * longest**3:
+                    continue
+                total += 1
+                kind = []
+                for x in tv:
+                    if x in own:
+                        kind.append("I")
+                    elif any(on_edge(x, a, b) for a, b in edges):
+                        kind.append("S")
+                    else:
+                        kind.append("F")
+                        heights.append(abs((P[x] - mean) @ nrm) / tol)
+                key = "".join(sorted(kind))
+                kinds[key] = kinds.get(key, 0) + 1
+                if "--list" in argv:
+                    print(f"group {gi} ({len(group)} polygons) tet {tv} kinds {''.join(kind)}")
+    print(f"shims: {total}")
+    for key, n in sorted(kinds.items(), key=lambda x: -x[1]):
+        print(f"  {key}: {n}")
+    if heights:
+        q = np.percentile(heights, [0, 25, 50, 75, 100])
+        print(f"foreign vertices: {len(heights)}; height / slab half-thickness: "
+              f"min {q[0]:.2f}, quartiles {q[1]:.2f} {q[2]:.2f} {q[3]:.2f}, max {q[4]:.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
