@@ -384,35 +384,53 @@ fn largest_triangle(cdt: &Cdt, region: &Region) -> [Point; 3] {
     [a, b, c]
 }
 
+/// One vertex's mark: the region it was marked for (a stamp), its side and its height,
+/// side by side, so that a lookup reads one place in memory.
+#[derive(Clone, Copy)]
+struct Mark {
+    stamp: u32,
+    side: i8,
+    h: Approx,
+}
+
 /// Per-vertex sides and heights for one region: an array indexed by vertex id, kept
-/// from one region to the next, valid where the stamped set holds the vertex.
+/// from one region to the next, valid where a mark carries the region's stamp.
 /// Per-region hash maps cost more than the flips themselves, and clearing arrays the
 /// size of the mesh for every region would cost more still.
 struct Marks {
-    members: SlotSet,
-    vert: Vec<(i8, Approx)>,
+    vert: Vec<Mark>,
+    /// The stamp of the current region.
+    now: u32,
 }
 
 thread_local! {
-    static MARKS: std::cell::RefCell<Vec<(i8, Approx)>> = const { std::cell::RefCell::new(Vec::new()) };
+    static MARKS: std::cell::RefCell<(Vec<Mark>, u32)> = const { std::cell::RefCell::new((Vec::new(), 0)) };
 }
 
 impl Marks {
     /// Starts a region: no vertex marked, arrays large enough for the mesh.
     fn new(verts: usize) -> Self {
-        let mut vert = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
+        let (mut vert, now) = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
+        let mut now = now.wrapping_add(1);
+        if now == 0 {
+            vert.iter_mut().for_each(|m| m.stamp = 0);
+            now = 1;
+        }
         if vert.len() < verts {
-            vert.resize(verts, (0, Approx { v: 0.0, p: 0.0 }));
+            let blank = Mark {
+                stamp: 0,
+                side: 0,
+                h: Approx { v: 0.0, p: 0.0 },
+            };
+            vert.resize(verts, blank);
         }
-        Marks {
-            members: SlotSet::new(verts),
-            vert,
-        }
+        Marks { vert, now }
     }
 
     #[inline]
     fn side(&self, v: VertexId) -> Option<(i8, Approx)> {
-        self.members.contains(&v).then(|| self.vert[v as usize])
+        let m = self.vert.get(v as usize)?;
+        (m.stamp == self.now).then_some((m.side, m.h))
     }
 
     /// The side of vertex `v` at `p`, marked now if it was not: 0 on the polygon
@@ -429,8 +447,11 @@ impl Marks {
             return s;
         }
         let s = if on_polygon() { 0 } else { lift.side(p) as i8 };
-        self.members.insert(v);
-        self.vert[v as usize] = (s, lift.height_approx(p, s == 1));
+        self.vert[v as usize] = Mark {
+            stamp: self.now,
+            side: s,
+            h: lift.height_approx(p, s == 1),
+        };
         s
     }
 }
@@ -438,7 +459,8 @@ impl Marks {
 impl Drop for Marks {
     fn drop(&mut self) {
         let vert = std::mem::take(&mut self.vert);
-        MARKS.with(|m| *m.borrow_mut() = vert);
+        let now = self.now;
+        MARKS.with(|m| *m.borrow_mut() = (vert, now));
     }
 }
 
