@@ -611,14 +611,6 @@ impl SlotSet {
         self.stamp[i] = self.now;
         fresh
     }
-
-    /// Takes tet `t` out of the set.
-    #[inline]
-    pub(crate) fn remove(&mut self, t: TetId) {
-        if let Some(x) = self.stamp.get_mut(t as usize) {
-            *x = 0;
-        }
-    }
 }
 
 impl Drop for SlotSet {

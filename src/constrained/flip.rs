@@ -20,7 +20,7 @@
 //! algorithm does.
 
 use super::bistellar::{self, Few, Kind};
-use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats, SlotSet};
+use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
 use super::cdt::{edge_key, face_key, Cdt};
 use super::flip_queue::{FlipQueue, Interval, Order};
 use crate::error::MeshError;
@@ -464,54 +464,83 @@ impl Drop for Marks {
     }
 }
 
+/// Per tet slot: its generation and its region stamp (see [`Gens`]).
+type SlotGens = Vec<(u32, u32)>;
+
 /// Generations of the tet slots: every tet the flips make or delete gets a number never
 /// used before, so an event whose tets have changed, even into a slot reused for
 /// another tet, is recognised by two array reads. Kept from one region to the next
 /// (numbers only grow), since only the flips change tets while a region is processed.
+/// Also which slots hold tets of R, by a stamp per region.
 struct Gens {
-    of: Vec<u32>,
+    /// Per tet slot: its generation, and the stamp of the region whose R holds it (one
+    /// entry, since a tet's generation is read right after its membership).
+    of: SlotGens,
     next: u32,
+    /// The stamp of the current region.
+    now: u32,
 }
 
 thread_local! {
-    static GENS: std::cell::RefCell<(Vec<u32>, u32)> = const { std::cell::RefCell::new((Vec::new(), 1)) };
+    static GENS: std::cell::RefCell<(SlotGens, u32, u32)> =
+        const { std::cell::RefCell::new((Vec::new(), 1, 0)) };
 }
 
 impl Gens {
+    /// Starts a region with R empty.
     fn new(slots: usize) -> Self {
-        let (mut of, mut next) = GENS.with(|g| std::mem::take(&mut *g.borrow_mut()));
+        let (mut of, mut next, now) = GENS.with(|g| std::mem::take(&mut *g.borrow_mut()));
         // Numbers start afresh (between regions, when no event is pending) long before
         // they could wrap: one region would need 2^31 tet changes to wrap them.
         if next == 0 || next > 1 << 31 {
-            of.iter_mut().for_each(|g| *g = 0);
+            of.iter_mut().for_each(|g| g.0 = 0);
             next = 1;
         }
-        if of.len() < slots {
-            of.resize(slots, 0);
+        let mut now = now.wrapping_add(1);
+        if now == 0 {
+            of.iter_mut().for_each(|g| g.1 = 0);
+            now = 1;
         }
-        Gens { of, next }
+        if of.len() < slots {
+            of.resize(slots, (0, 0));
+        }
+        Gens { of, next, now }
     }
 
     #[inline]
     fn of(&self, t: TetId) -> u32 {
-        self.of.get(t as usize).copied().unwrap_or(0)
+        self.of.get(t as usize).map_or(0, |g| g.0)
     }
 
     /// Gives slot `t` a new generation: its tet was made or deleted.
     fn renew(&mut self, t: TetId) {
         if self.of.len() <= t as usize {
-            self.of.resize(t as usize + 1, 0);
+            self.of.resize(t as usize + 1, (0, 0));
         }
-        self.of[t as usize] = self.next;
+        self.of[t as usize].0 = self.next;
         self.next += 1;
+    }
+
+    /// Is tet `t` in R?
+    #[inline]
+    fn in_r(&self, t: TetId) -> bool {
+        self.of.get(t as usize).is_some_and(|g| g.1 == self.now)
+    }
+
+    /// Puts tet `t` in R, or (`false`) takes it out.
+    fn set_in_r(&mut self, t: TetId, inside: bool) {
+        if self.of.len() <= t as usize {
+            self.of.resize(t as usize + 1, (0, 0));
+        }
+        self.of[t as usize].1 = if inside { self.now } else { 0 };
     }
 }
 
 impl Drop for Gens {
     fn drop(&mut self) {
         let of = std::mem::take(&mut self.of);
-        let next = self.next;
-        GENS.with(|g| *g.borrow_mut() = (of, next));
+        let (next, now) = (self.next, self.now);
+        GENS.with(|g| *g.borrow_mut() = (of, next, now));
     }
 }
 
@@ -533,13 +562,12 @@ struct Flipper<'a> {
     lift: Lifting,
     /// Per-vertex sides and heights, in arrays stamped for this region.
     marks: Marks,
-    /// The tets in R (they change as flips replace them).
-    in_r: SlotSet,
     /// The tets put in R (some since flipped away: filter with `in_r`).
     r_list: Vec<TetId>,
     region_faces: FxHashSet<[VertexId; 3]>,
     events: Vec<Event>,
-    /// Tet generations, for [`Flipper::valid`].
+    /// Tet generations, for [`Flipper::valid`], and which tets are in R now (they
+    /// change as flips replace them).
     gens: Gens,
     /// Event slots free for reuse.
     free_events: Vec<u32>,
@@ -579,10 +607,9 @@ struct Flipper<'a> {
 impl<'a> Flipper<'a> {
     fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
         let mut marks = Marks::new(cdt.dt.points.len());
-        let cdt_slots = cdt.dt.mesh.num_slots();
-        let mut in_r = SlotSet::new(cdt.dt.mesh.num_slots());
+        let mut gens = Gens::new(cdt.dt.mesh.num_slots());
         for &t in crossing {
-            in_r.insert(t);
+            gens.set_in_r(t, true);
             for v in cdt.dt.mesh.verts(t) {
                 let p = &cdt.dt.points[v as usize];
                 marks.mark(v, p, || region.verts.contains(&v), &lift);
@@ -593,11 +620,10 @@ impl<'a> Flipper<'a> {
             region,
             lift,
             marks,
-            in_r,
             r_list: crossing.to_vec(),
             region_faces: region.tris.iter().map(|t| face_key(*t)).collect(),
             events: Vec::new(),
-            gens: Gens::new(cdt_slots),
+            gens,
             free_events: Vec::new(),
             queue: Some(Box::new(FlipQueue::new())),
             deferred: Vec::new(),
@@ -807,7 +833,7 @@ impl<'a> Flipper<'a> {
     /// Is tet `t` in R?
     #[inline]
     fn in_r(&self, t: TetId) -> bool {
-        self.in_r.contains(&t)
+        self.gens.in_r(t)
     }
 
     /// The tets of R now, without repeats, in increasing order.
@@ -1149,12 +1175,12 @@ impl<'a> Flipper<'a> {
             }
         })?;
         for &t in sh.old.iter() {
-            self.in_r.remove(t);
+            self.gens.set_in_r(t, false);
             self.gens.renew(t);
         }
         for &t in made.iter() {
             self.gens.renew(t);
-            self.in_r.insert(t);
+            self.gens.set_in_r(t, true);
             self.r_list.push(t);
         }
         Ok(made)
