@@ -403,11 +403,7 @@ impl SideCache {
         let mut c = SIDE_CACHE
             .with(|c| c.borrow_mut().take())
             .unwrap_or(SideCache::EMPTY);
-        c.stamp = c.stamp.wrapping_add(1);
-        if c.stamp == 0 {
-            c.rows.iter_mut().for_each(|r| r.0 = 0);
-            c.stamp = 1;
-        }
+        c.stamp = next_stamp(c.stamp, &mut c.rows, |r| &mut r.0);
         c.buf.clear();
         c
     }
@@ -563,6 +559,23 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
 /// A set of tets (or of other dense ids, such as vertices) as a stamp per slot, in
 /// arrays kept from one use to the next: a hash set per region cost more than the
 /// region's own cavity work.
+/// The stamp after `now` for arrays whose entries are valid where they carry the current
+/// stamp: when the numbers wrap, every entry's stamp (`stamp_of`) is cleared first, so
+/// that no old entry carries the new one.
+pub(crate) fn next_stamp<T>(
+    now: u32,
+    items: &mut [T],
+    stamp_of: impl Fn(&mut T) -> &mut u32,
+) -> u32 {
+    match now.wrapping_add(1) {
+        0 => {
+            items.iter_mut().for_each(|x| *stamp_of(x) = 0);
+            1
+        }
+        next => next,
+    }
+}
+
 pub(crate) struct SlotSet {
     stamp: Vec<u32>,
     now: u32,
@@ -584,11 +597,7 @@ impl SlotSet {
 
     /// Empties the set, for `slots` slots (more may be added).
     pub(crate) fn clear(&mut self, slots: usize) {
-        self.now = self.now.wrapping_add(1);
-        if self.now == 0 {
-            self.stamp.iter_mut().for_each(|x| *x = 0);
-            self.now = 1;
-        }
+        self.now = next_stamp(self.now, &mut self.stamp, |x| x);
         if self.stamp.len() < slots {
             self.stamp.resize(slots, 0);
         }
@@ -1180,6 +1189,15 @@ mod tests {
     use super::*;
     use crate::delaunay::Delaunay;
     use crate::geom::lcg;
+
+    #[test]
+    fn stamps_that_wrap_clear_the_entries_first() {
+        let mut items = vec![(u32::MAX, 'a'), (7, 'b')];
+        assert_eq!(next_stamp(7, &mut items, |x| &mut x.0), 8);
+        assert_eq!(items[0].0, u32::MAX);
+        assert_eq!(next_stamp(u32::MAX, &mut items, |x| &mut x.0), 1);
+        assert!(items.iter().all(|x| x.0 == 0));
+    }
 
     /// Regions that cache their vertices' sides (fans of slivers from a far vertex, as
     /// fuzzing made, small and large, one after the other on one cache) answer every

@@ -411,11 +411,7 @@ impl Marks {
     /// Starts a region: no vertex marked, arrays large enough for the mesh.
     fn new(verts: usize) -> Self {
         let (mut vert, now) = MARKS.with(|m| std::mem::take(&mut *m.borrow_mut()));
-        let mut now = now.wrapping_add(1);
-        if now == 0 {
-            vert.iter_mut().for_each(|m| m.stamp = 0);
-            now = 1;
-        }
+        let now = cavity::next_stamp(now, &mut vert, |m| &mut m.stamp);
         if vert.len() < verts {
             let blank = Mark {
                 stamp: 0,
@@ -496,11 +492,7 @@ impl Gens {
             of.iter_mut().for_each(|g| g.0 = 0);
             next = 1;
         }
-        let mut now = now.wrapping_add(1);
-        if now == 0 {
-            of.iter_mut().for_each(|g| g.1 = 0);
-            now = 1;
-        }
+        let now = cavity::next_stamp(now, &mut of, |g| &mut g.1);
         if of.len() < slots {
             of.resize(slots, (0, 0));
         }
@@ -512,12 +504,17 @@ impl Gens {
         self.of.get(t as usize).map_or(0, |g| g.0)
     }
 
-    /// Gives slot `t` a new generation: its tet was made or deleted.
-    fn renew(&mut self, t: TetId) {
+    /// Slot `t`'s entry, the array grown to hold it.
+    fn slot(&mut self, t: TetId) -> &mut (u32, u32) {
         if self.of.len() <= t as usize {
             self.of.resize(t as usize + 1, (0, 0));
         }
-        self.of[t as usize].0 = self.next;
+        &mut self.of[t as usize]
+    }
+
+    /// Gives slot `t` a new generation: its tet was made or deleted.
+    fn renew(&mut self, t: TetId) {
+        self.slot(t).0 = self.next;
         self.next += 1;
     }
 
@@ -529,10 +526,8 @@ impl Gens {
 
     /// Puts tet `t` in R, or (`false`) takes it out.
     fn set_in_r(&mut self, t: TetId, inside: bool) {
-        if self.of.len() <= t as usize {
-            self.of.resize(t as usize + 1, (0, 0));
-        }
-        self.of[t as usize].1 = if inside { self.now } else { 0 };
+        let now = self.now;
+        self.slot(t).1 = if inside { now } else { 0 };
     }
 }
 
