@@ -53,22 +53,10 @@ def read_input(vm, path):
     return pts, polys, facet_of
 
 
-def main(argv):
-    vm = load_referee(argv)
-    args, skip = [], False
-    for a in argv:
-        if skip:
-            skip = False
-        elif a == "--tools":
-            skip = True
-        elif not a.startswith("--"):
-            args.append(a)
-    if len(args) != 2:
-        sys.exit(__doc__)
-    inp, prefix = args
-    ipts, polys, facet_of = read_input(vm, inp)
-    P, _raw, base, _ = vm.read_node(prefix + ".node")
-    T = vm.read_ele(prefix + ".ele", base)
+def find_shims(vm, ipts, polys, facet_of, P, T):
+    """The referee's shims in mesh (P, T) of the PLC (ipts, polys, facet_of): for each,
+    its merged group's index, its four vertices, their kinds (I, S or F) and the heights
+    of its foreign vertices as fractions of the slab's half-thickness."""
     where = {}
     for i, q in enumerate(map(tuple, P.tolist())):
         where.setdefault(q, i)
@@ -90,7 +78,7 @@ def main(argv):
         t = (P[v] - P[a]) @ d / length**2
         return 0 < t < 1 and np.linalg.norm(np.cross(P[v] - P[a], d)) / length < 1e-9 * diag
 
-    kinds, heights, total = {}, [], 0
+    found = []
     for gi, group in enumerate(groups):
         gpolys = [polys[i] for i in group if len(polys[i]) >= 3]
         if not gpolys:
@@ -117,8 +105,7 @@ def main(argv):
                 longest = max(np.linalg.norm(P[tv[i]] - P[tv[j]]) for i in range(4) for j in range(i + 1, 4))
                 if abs(det[t]) / 6.0 > 1e-3 * longest**3:
                     continue
-                total += 1
-                kind = []
+                kind, heights = [], []
                 for x in tv:
                     if x in own:
                         kind.append("I")
@@ -127,11 +114,35 @@ def main(argv):
                     else:
                         kind.append("F")
                         heights.append(abs((P[x] - mean) @ nrm) / tol)
-                key = "".join(sorted(kind))
-                kinds[key] = kinds.get(key, 0) + 1
-                if "--list" in argv:
-                    print(f"group {gi} ({len(group)} polygons) tet {tv} kinds {''.join(kind)}")
-    print(f"shims: {total}")
+                found.append((gi, tv, "".join(kind), heights))
+    return found
+
+
+def main(argv):
+    vm = load_referee(argv)
+    args, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == "--tools":
+            skip = True
+        elif not a.startswith("--"):
+            args.append(a)
+    if len(args) != 2:
+        sys.exit(__doc__)
+    inp, prefix = args
+    ipts, polys, facet_of = read_input(vm, inp)
+    P, _raw, base, _ = vm.read_node(prefix + ".node")
+    T = vm.read_ele(prefix + ".ele", base)
+    kinds, heights = {}, []
+    found = find_shims(vm, ipts, polys, facet_of, P, T)
+    for gi, tv, kind, h in found:
+        heights.extend(h)
+        key = "".join(sorted(kind))
+        kinds[key] = kinds.get(key, 0) + 1
+        if "--list" in argv:
+            print(f"group {gi} tet {tv} kinds {kind}")
+    print(f"shims: {len(found)}")
     for key, n in sorted(kinds.items(), key=lambda x: -x[1]):
         print(f"  {key}: {n}")
     if heights:
