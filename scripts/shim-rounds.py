@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Rounds of changes to a model's input against the shims the referee counts.
 
-usage: scripts/shim-rounds.py MODEL.off ROUNDS [--lens free|proj|mid]
+usage: scripts/shim-rounds.py MODEL.off ROUNDS [--lens free|proj|mid] [--lens-after N]
+           [--fallback-mid]
            [--presplit APEX,APEX,... [--per-doubling N] [--from R] [--phase] [--fan-degrees D]]
            [--bin PATH] [--tools DIR] [--work DIR]
 
@@ -21,7 +22,9 @@ number, and adds points for the next round:
     `proj` splits a subsegment among its edges at the projection of one of its other
     vertices, where that falls in the piece's middle 80%; `mid` splits its longest
     subsegment at the midpoint. A split is an extra vertex of every polygon on the
-    input edge.
+    input edge. With --lens-after N such shims are treated as by `free` in the first N
+    rounds; with --fallback-mid, `proj` splits at the midpoint where no projection falls
+    inside.
 
 --presplit splits, before the first round, every input edge that meets another at one
 of the given apexes at under --fan-degrees (8) on the radii 2^(k/N) (N from
@@ -158,7 +161,7 @@ def add_free(model, P, T, centroid, u, d):
     return False
 
 
-def split(model, V, how):
+def split(model, V, how, fallback=False):
     """Splits a subsegment among the tet's edges (`proj` or `mid`); whether it did."""
     best = None
     for i in range(4):
@@ -181,6 +184,8 @@ def split(model, V, how):
                 if ti + 0.1 * (tj - ti) < tm < tj - 0.1 * (tj - ti):
                     best = (length, k, float(tm))
                     break
+    if best is None and fallback:
+        return split(model, V, "mid")
     if best is None:
         return False
     model.splits.setdefault(best[1], []).append(best[2])
@@ -190,12 +195,13 @@ def split(model, V, how):
 def main(argv):
     report = load_report()
     vm = report.load_referee(argv)
-    valued = {"--lens", "--presplit", "--per-doubling", "--from", "--fan-degrees", "--bin", "--tools", "--work"}
+    valued = {"--lens", "--lens-after", "--presplit", "--per-doubling", "--from", "--fan-degrees", "--bin", "--tools", "--work"}
     args = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in valued)]
     if len(args) != 2 or not args[0].endswith(".off"):
         sys.exit(__doc__)
     path, rounds = args[0], int(args[1])
     lens = option(argv, "--lens", "free")
+    lens_after = int(option(argv, "--lens-after", "0"))
     if lens not in ("free", "proj", "mid"):
         sys.exit(__doc__)
     binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
@@ -234,10 +240,10 @@ def main(argv):
                 toward = normal
             if inside(P, T, centroid + toward * longest * 0.25):
                 free += add_free(model, P, T, centroid, toward, longest)
-            elif lens == "free":
+            elif lens == "free" or r < lens_after:
                 free += add_free(model, P, T, centroid, -toward, longest)
             else:
-                splits += split(model, V, lens)
+                splits += split(model, V, lens, "--fallback-mid" in argv)
         print(f"   adding {free} free points and {splits} split points", flush=True)
     print("shims by round:", ", ".join(map(str, history)))
 
