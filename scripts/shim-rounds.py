@@ -32,7 +32,7 @@ of the given apexes at under --fan-degrees (8) on the radii 2^(k/N) (N from
 by a fraction of a step of its own, so that no two edges share a radius.
 
 Only .off models (triangles or polygons without holes). It needs numpy; a round of
-112544.off takes about 40 s.
+112544.off takes 20 to 40 s.
 """
 import importlib.util
 import math
