@@ -2,7 +2,7 @@
 """Rounds of changes to a model's input against the shims the referee counts.
 
 usage: scripts/shim-rounds.py MODEL.off ROUNDS [--lens free|proj|mid] [--lens-after N]
-           [--fallback-mid]
+           [--fallback-mid] [--margin M]
            [--presplit APEX,APEX,... [--per-doubling N] [--from R] [--phase] [--fan-degrees D]]
            [--bin PATH] [--tools DIR] [--work DIR]
 
@@ -20,9 +20,9 @@ number, and adds points for the next round:
   - a shim whose circumcentre lies beyond the surface is treated by --lens:
     `free` (the default) puts the free point on the other side, the domain's;
     `proj` splits a subsegment among its edges at the projection of one of its other
-    vertices, where that falls in the piece's middle 80%; `mid` splits its longest
-    subsegment at the midpoint. A split is an extra vertex of every polygon on the
-    input edge. With --lens-after N such shims are treated as by `free` in the first N
+    vertices, where that falls in the piece's middle (all but a fraction --margin, 0.1,
+    at either end); `mid` splits its longest subsegment at the midpoint. A split is an
+    extra vertex of every polygon on the input edge. With --lens-after N such shims are treated as by `free` in the first N
     rounds; with --fallback-mid, `proj` splits at the midpoint where no projection falls
     inside.
 
@@ -161,7 +161,7 @@ def add_free(model, P, T, centroid, u, d):
     return False
 
 
-def split(model, V, how, fallback=False):
+def split(model, V, how, fallback=False, margin=0.1):
     """Splits a subsegment among the tet's edges (`proj` or `mid`); whether it did."""
     best = None
     for i in range(4):
@@ -181,7 +181,7 @@ def split(model, V, how, fallback=False):
                 continue
             for m in set(range(4)) - {i, j}:
                 tm = (V[m] - a) @ d / (d @ d)
-                if ti + 0.1 * (tj - ti) < tm < tj - 0.1 * (tj - ti):
+                if ti + margin * (tj - ti) < tm < tj - margin * (tj - ti):
                     best = (length, k, float(tm))
                     break
     if best is None and fallback:
@@ -195,7 +195,7 @@ def split(model, V, how, fallback=False):
 def main(argv):
     report = load_report()
     vm = report.load_referee(argv)
-    valued = {"--lens", "--lens-after", "--presplit", "--per-doubling", "--from", "--fan-degrees", "--bin", "--tools", "--work"}
+    valued = {"--lens", "--lens-after", "--margin", "--presplit", "--per-doubling", "--from", "--fan-degrees", "--bin", "--tools", "--work"}
     args = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in valued)]
     if len(args) != 2 or not args[0].endswith(".off"):
         sys.exit(__doc__)
@@ -243,7 +243,8 @@ def main(argv):
             elif lens == "free" or r < lens_after:
                 free += add_free(model, P, T, centroid, -toward, longest)
             else:
-                splits += split(model, V, lens, "--fallback-mid" in argv)
+                splits += split(model, V, lens, "--fallback-mid" in argv,
+                                float(option(argv, "--margin", "0.1")))
         print(f"   adding {free} free points and {splits} split points", flush=True)
     print("shims by round:", ", ".join(map(str, history)))
 
