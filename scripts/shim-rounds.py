@@ -202,6 +202,7 @@ def main(argv):
     path, rounds = args[0], int(args[1])
     lens = option(argv, "--lens", "free")
     lens_after = int(option(argv, "--lens-after", "0"))
+    fallback, margin = "--fallback-mid" in argv, float(option(argv, "--margin", "0.1"))
     if lens not in ("free", "proj", "mid"):
         sys.exit(__doc__)
     binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
@@ -243,8 +244,7 @@ def main(argv):
             elif lens == "free" or r < lens_after:
                 free += add_free(model, P, T, centroid, -toward, longest)
             else:
-                splits += split(model, V, lens, "--fallback-mid" in argv,
-                                float(option(argv, "--margin", "0.1")))
+                splits += split(model, V, lens, fallback, margin)
         print(f"   adding {free} free points and {splits} split points", flush=True)
     print("shims by round:", ", ".join(map(str, history)))
 

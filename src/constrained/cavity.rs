@@ -556,9 +556,6 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     region.crossed_by_tet(&cdt.dt.points, v)
 }
 
-/// A set of tets (or of other dense ids, such as vertices) as a stamp per slot, in
-/// arrays kept from one use to the next: a hash set per region cost more than the
-/// region's own cavity work.
 /// The stamp after `now` for arrays whose entries are valid where they carry the current
 /// stamp: when the numbers wrap, every entry's stamp (`stamp_of`) is cleared first, so
 /// that no old entry carries the new one.
@@ -576,6 +573,9 @@ pub(crate) fn next_stamp<T>(
     }
 }
 
+/// A set of tets (or of other dense ids, such as vertices) as a stamp per slot, in
+/// arrays kept from one use to the next: a hash set per region cost more than the
+/// region's own cavity work.
 pub(crate) struct SlotSet {
     stamp: Vec<u32>,
     now: u32,
