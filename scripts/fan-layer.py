@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""Rings on the spokes of needle fans and a layer of free points above them, against the
+shims the referee counts.
+
+usage: scripts/fan-layer.py MODEL.off WORK_DIR --apexes A,B,... [--ring-c C] [--r0 R0]
+           [--height-factor F] [--skip-encroaching K] [--no-free] [--flags FLAGS]
+           [--bin PATH] [--tools DIR]
+
+The eighteenth round's experiment on attene_cdt/112544.off (see the README). At each
+apex, the input edges that meet another edge there at under 8 degrees (the spokes of a
+fan of needle triangles) are split on the same radii, r0 and then r + C*sqrt(r) (C from
+--ring-c, 0.004; r0 from --r0, 0.01), so that the pieces of neighbouring spokes form
+isosceles trapezoids (cocircular, so the flat tets folded over a spoke have their
+circumspheres centred near the surface, not far beyond it). Every cell between two
+spokes of a fan triangle then gets a free point (an isolated node of the .poly) above
+its centre, on the domain's side, at F (--height-factor, 1.5) times the largest slab
+half-thickness the referee gives the fan's merged facets: inside the folded tets'
+circumspheres, outside every slab. With --skip-encroaching K, a cell gets no point when
+its spoke pieces could no longer be Delaunay edges with the point in (half the piece
+squared over twice the height exceeding K times the spokes' distance apart there).
+
+It writes WORK_DIR/cur.poly (every triangle a facet), meshes it with FLAGS (default
+`-pQM`) into WORK_DIR/out, and prints the shims by merged facet and by distance from the
+first apex. It needs numpy.
+"""
+import importlib.util
+import math
+import os
+import subprocess
+import sys
+from collections import Counter
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def option(argv, name, default):
+    return argv[argv.index(name) + 1] if name in argv else default
+
+
+def load(name, file):
+    spec = importlib.util.spec_from_file_location(name, os.path.join(HERE, file))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def slabs(vm, model):
+    """The referee's slab half-thickness of each polygon's merged facet."""
+    groups, _ = vm.merge_coplanar(model.pts, model.polys, model.facet_of)
+    tol = {}
+    for g in groups:
+        normals = [vm.newell_normal(model.pts[model.polys[i]]) for i in g]
+        n = normals[int(np.argmax([np.linalg.norm(x) for x in normals]))]
+        n = n / np.linalg.norm(n)
+        own = model.pts[sorted({v for i in g for v in model.polys[i]})]
+        t = max(1e-10 * model.diag, 4 * np.abs((own - own.mean(0)) @ n).max())
+        tol.update((i, t) for i in g)
+    return tol
+
+
+class Surface:
+    """The input triangles: which side of them a point is on, and how far."""
+
+    def __init__(self, model):
+        tris = np.array([(p[0], p[k], p[k + 1]) for p in model.polys for k in range(1, len(p) - 1)])
+        self.a, self.b, self.c = (model.pts[tris[:, i]] for i in range(3))
+        self.centre = (self.a + self.b + self.c) / 3
+        self.radius = np.max([np.linalg.norm(x - self.centre, axis=1) for x in (self.a, self.b, self.c)], axis=0)
+
+    def inside(self, o):
+        """Ray parity along a direction no input edge is likely to lie on."""
+        d = np.array([0.5773, 0.5774, 0.5775])
+        e1, e2 = self.b - self.a, self.c - self.a
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-300
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = o - self.a
+        u = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        v = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        return int((ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)).sum()) % 2 == 1
+
+    def distance(self, x, reach):
+        """Distance from `x` to the nearest triangle, if under `reach` (else inf)."""
+        near = np.linalg.norm(self.centre - x, axis=1) <= self.radius + reach
+        if not near.any():
+            return math.inf
+        a, b, c = self.a[near], self.b[near], self.c[near]
+        n = np.cross(b - a, c - a)
+        n = n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        h = np.einsum("ij,ij->i", x - a, n)
+        q = x - h[:, None] * n
+
+        def side(u, v):
+            return np.einsum("ij,ij->i", np.cross(v - u, q - u), n)
+
+        def seg(u, v):
+            d = v - u
+            t = np.clip(np.einsum("ij,ij->i", x - u, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0, 1)
+            return np.linalg.norm(u + t[:, None] * d - x, axis=1)
+
+        within = (side(a, b) >= 0) & (side(b, c) >= 0) & (side(c, a) >= 0)
+        edge = np.minimum(np.minimum(seg(a, b), seg(b, c)), seg(c, a))
+        return float(np.where(within, np.abs(h), edge).min())
+
+
+def fan_edges(model, apex):
+    """The input edges at `apex` that meet another there at under 8 degrees, with lengths."""
+    at = [k for k, e in enumerate(model.edges) if apex in e]
+    direction = {}
+    for k in at:
+        d = model.pts[sum(model.edges[k]) - apex] - model.pts[apex]
+        direction[k] = (d / np.linalg.norm(d), float(np.linalg.norm(d)))
+    cos_max = math.cos(math.radians(8))
+    fan = {i for i in at for j in at if i != j and direction[i][0] @ direction[j][0] > cos_max}
+    return {k: direction[k] for k in fan}
+
+
+def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
+    """Splits the fan's spokes on shared rings and returns the free points above its cells."""
+    fan = fan_edges(model, apex)
+    if not fan:
+        return 0, 0, []
+    radii = [r0]
+    longest = max(length for _, length in fan.values())
+    while radii[-1] < longest:
+        radii.append(radii[-1] + ring_c * math.sqrt(radii[-1]))
+    for k, (_, length) in fan.items():
+        a, _b = model.edges[k]
+        model.splits[k] = [r / length if a == apex else 1 - r / length for r in radii if r < 0.98 * length]
+    polys = [i for i, p in enumerate(model.polys) if apex in p]
+    height = factor * max(tol[i] for i in polys)
+    points = []
+    for i in polys:
+        p = model.polys[i]
+        j = p.index(apex)
+        ends = [p[(j + 1) % len(p)], p[j - 1]]
+        ks = [model.edges.index((min(apex, e), max(apex, e))) for e in ends]
+        if not all(k in fan for k in ks):
+            continue
+        (du, lu), (dv, lv) = fan[ks[0]], fan[ks[1]]
+        normal = model.pts[p]
+        n = np.cross(normal[1] - normal[0], normal[2] - normal[0])
+        n /= np.linalg.norm(n)
+        angle = math.acos(min(1.0, float(du @ dv)))
+        rr = [0.0] + [r for r in radii if r < 0.98 * min(lu, lv)]
+        side = None
+        for r1, r2 in zip(rr, rr[1:]):
+            piece, apart = r2 - r1, angle * (r1 + r2) / 2
+            if skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
+                continue
+            m = model.pts[apex] + (du + dv) / 2 * (r1 + r2) / 2
+            if side is None:
+                side = 1.0 if surface.inside(m + n * height) else -1.0
+            x = m + side * n * height
+            if surface.distance(x, 2 * height) >= 0.9 * height and surface.inside(x):
+                points.append(x.tolist())
+    return len(fan), len(radii), points
+
+
+def main(argv):
+    shim_rounds = load("shim_rounds", "shim-rounds.py")
+    report = shim_rounds.load_report()
+    vm = report.load_referee(argv)
+    valued = {"--apexes", "--ring-c", "--r0", "--height-factor", "--skip-encroaching", "--flags", "--bin", "--tools"}
+    args = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in valued)]
+    if len(args) != 2 or not args[0].endswith(".off") or "--apexes" not in argv:
+        sys.exit(__doc__)
+    path, work = args
+    apexes = [int(v) for v in option(argv, "--apexes", "").split(",") if v]
+    ring_c = float(option(argv, "--ring-c", "0.004"))
+    r0 = float(option(argv, "--r0", "0.01"))
+    factor = float(option(argv, "--height-factor", "1.5"))
+    skip = float(option(argv, "--skip-encroaching", "0"))
+    flags = option(argv, "--flags", "-pQM").split()
+    binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
+    os.makedirs(work, exist_ok=True)
+    model = shim_rounds.Model(vm, path)
+    tol = slabs(vm, model)
+    surface = Surface(model)
+    for apex in apexes:
+        edges, rings, points = layer(model, surface, tol, apex, ring_c, r0, factor, skip)
+        if "--no-free" not in argv:
+            model.free.extend(points)
+        print(f"apex {apex}: {edges} spokes, {rings} rings, {len(points)} free points", flush=True)
+    poly, out = os.path.join(work, "cur.poly"), os.path.join(work, "out")
+    model.write_poly(poly)
+    run = subprocess.run([binary, *flags, poly, "-o", out], capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"tetcdt exited {run.returncode}: {run.stderr.strip()[-400:]}")
+    P, _raw, base, _ = vm.read_node(out + ".node")
+    T = vm.read_ele(out + ".ele", base)
+    found = report.find_shims(vm, model.pts, model.polys, model.facet_of, P, T)
+    print(f"{len(P)} points, {len(T)} tets, {len(found)} shims")
+    print("by merged facet:", ", ".join(f"{g}: {n}" for g, n in Counter(g for g, *_ in found).most_common(10)))
+    bands = [0, 0.01, 0.1, 1, 3, math.inf]
+    dist = [float(np.linalg.norm(P[tv].mean(0) - model.pts[apexes[0]])) for _g, tv, *_ in found]
+    counts = np.histogram(dist, bins=bands)[0] if dist else [0] * (len(bands) - 1)
+    print(f"by distance from apex {apexes[0]}:",
+          ", ".join(f"[{lo}, {hi}): {n}" for lo, hi, n in zip(bands, bands[1:], counts)))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
