@@ -16,8 +16,10 @@ spokes of a fan triangle then gets a free point (an isolated node of the .poly) 
 its centre, on the domain's side, at F (--height-factor, 1.5) times the largest slab
 half-thickness the referee gives the fan's merged facets: inside the folded tets'
 circumspheres, outside every slab. With --skip-encroaching K, a cell gets no point when
-its spoke pieces could no longer be Delaunay edges with the point in (half the piece
-squared over twice the height exceeding K times the spokes' distance apart there).
+its spoke pieces could no longer be Delaunay edges with the point in: when a sphere
+through a piece's ends must lie deeper than K times the spokes' distance apart there to
+leave the point out (that depth is (p^2/4 - h^2)/(2h) for a piece p long and a point h
+high).
 
 It writes WORK_DIR/cur.poly (every triangle a facet), meshes it with FLAGS (default
 `-pQM`) into WORK_DIR/out, and prints the shims by merged facet and by distance from the
@@ -85,7 +87,8 @@ class Surface:
         return int((ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)).sum()) % 2 == 1
 
     def distance(self, x, reach):
-        """Distance from `x` to the nearest triangle, if under `reach` (else inf)."""
+        """Distance from `x` to the nearest triangle that comes within `reach` of it (inf
+        if none does)."""
         near = np.linalg.norm(self.centre - x, axis=1) <= self.radius + reach
         if not near.any():
             return math.inf
@@ -143,8 +146,8 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
         if not all(k in fan for k in ks):
             continue
         (du, lu), (dv, lv) = fan[ks[0]], fan[ks[1]]
-        normal = model.pts[p]
-        n = np.cross(normal[1] - normal[0], normal[2] - normal[0])
+        corners = model.pts[p]
+        n = np.cross(corners[1] - corners[0], corners[2] - corners[0])
         n /= np.linalg.norm(n)
         angle = math.acos(min(1.0, float(du @ dv)))
         rr = [0.0] + [r for r in radii if r < 0.98 * min(lu, lv)]
