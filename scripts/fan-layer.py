@@ -14,7 +14,7 @@ isosceles trapezoids (cocircular, so the flat tets folded over a spoke have thei
 circumspheres centred near the surface, not far beyond it). Every cell between two
 spokes of a fan triangle then gets a free point (an isolated node of the .poly) above
 its centre, on the domain's side, at F (--height-factor, 1.5) times the largest slab
-half-thickness the referee gives the fan's merged facets: inside the folded tets'
+half-thickness the referee gives the merged facets at the apex: inside the folded tets'
 circumspheres, outside every slab. With --skip-encroaching K, a cell gets no point when
 its spoke pieces could no longer be Delaunay edges with the point in: when a sphere
 through a piece's ends must lie deeper than K times the spokes' distance apart there to
