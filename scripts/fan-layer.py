@@ -37,10 +37,6 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def option(argv, name, default):
-    return argv[argv.index(name) + 1] if name in argv else default
-
-
 def load(name, file):
     spec = importlib.util.spec_from_file_location(name, os.path.join(HERE, file))
     mod = importlib.util.module_from_spec(spec)
@@ -167,6 +163,7 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
 
 def main(argv):
     shim_rounds = load("shim_rounds", "shim-rounds.py")
+    option = shim_rounds.option
     report = shim_rounds.load_report()
     vm = report.load_referee(argv)
     valued = {"--apexes", "--ring-c", "--r0", "--height-factor", "--skip-encroaching", "--flags", "--bin", "--tools"}
