@@ -44,16 +44,12 @@ def load(name, file):
     return mod
 
 
-def slabs(vm, model):
+def slabs(vm, report, model):
     """The referee's slab half-thickness of each polygon's merged facet."""
     groups, _ = vm.merge_coplanar(model.pts, model.polys, model.facet_of)
     tol = {}
     for g in groups:
-        normals = [vm.newell_normal(model.pts[model.polys[i]]) for i in g]
-        n = normals[int(np.argmax([np.linalg.norm(x) for x in normals]))]
-        n = n / np.linalg.norm(n)
-        own = model.pts[sorted({v for i in g for v in model.polys[i]})]
-        t = max(1e-10 * model.diag, 4 * np.abs((own - own.mean(0)) @ n).max())
+        t = report.group_slab(vm, model.pts, [model.polys[i] for i in g], model.diag)[3]
         tol.update((i, t) for i in g)
     return tol
 
@@ -108,15 +104,12 @@ class Surface:
 
 
 def fan_edges(model, apex):
-    """The input edges at `apex` that meet another there at under 8 degrees, with lengths."""
-    at = [k for k, e in enumerate(model.edges) if apex in e]
-    direction = {}
-    for k in at:
+    """The spokes of the fan at `apex` (see shim-rounds.py), with directions and lengths."""
+    fan = {}
+    for k in model.fan_edges(apex, 8):
         d = model.pts[sum(model.edges[k]) - apex] - model.pts[apex]
-        direction[k] = (d / np.linalg.norm(d), float(np.linalg.norm(d)))
-    cos_max = math.cos(math.radians(8))
-    fan = {i for i in at for j in at if i != j and direction[i][0] @ direction[j][0] > cos_max}
-    return {k: direction[k] for k in fan}
+        fan[k] = (d / np.linalg.norm(d), float(np.linalg.norm(d)))
+    return fan
 
 
 def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
@@ -180,7 +173,7 @@ def main(argv):
     binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
     os.makedirs(work, exist_ok=True)
     model = shim_rounds.Model(vm, path)
-    tol = slabs(vm, model)
+    tol = slabs(vm, report, model)
     surface = Surface(model)
     for apex in apexes:
         edges, rings, points = layer(model, surface, tol, apex, ring_c, r0, factor, skip)

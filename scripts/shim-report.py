@@ -53,6 +53,19 @@ def read_input(vm, path):
     return pts, polys, facet_of
 
 
+def group_slab(vm, P, gpolys, diag):
+    """The referee's plane and slab for a merged group's polygons, computed as it computes
+    them: the unit normal of the largest polygon, the group's vertices, their mean, and
+    the slab's half-thickness."""
+    normals = [vm.newell_normal(P[q]) for q in gpolys]
+    nrm = normals[int(np.argmax([np.linalg.norm(n) for n in normals]))]
+    nrm = nrm / np.linalg.norm(nrm)
+    own = sorted({v for q in gpolys for v in q})
+    mean = P[own].mean(0)
+    tol = max(1e-10 * diag, 4 * np.abs((P[own] - mean) @ nrm).max())
+    return nrm, own, mean, tol
+
+
 def find_shims(vm, ipts, polys, facet_of, P, T):
     """The referee's shims in mesh (P, T) of the PLC (ipts, polys, facet_of): for each,
     its merged group's index, its four vertices, their kinds (I, S or F) and the heights
@@ -83,14 +96,8 @@ def find_shims(vm, ipts, polys, facet_of, P, T):
         gpolys = [polys[i] for i in group if len(polys[i]) >= 3]
         if not gpolys:
             continue
-        # The referee's slab and box for this group, computed as it computes them.
-        normals = [vm.newell_normal(P[q]) for q in gpolys]
-        nrm = normals[int(np.argmax([np.linalg.norm(n) for n in normals]))]
-        nrm = nrm / np.linalg.norm(nrm)
-        own = sorted({v for q in gpolys for v in q})
+        nrm, own, mean, tol = group_slab(vm, P, gpolys, diag)
         Q = P[own]
-        mean = Q.mean(0)
-        tol = max(1e-10 * diag, 4 * np.abs((Q - mean) @ nrm).max())
         lo, hi = Q.min(0) - tol, Q.max(0) + tol
         S = P[steiner]
         near = np.all((S >= lo) & (S <= hi), axis=1) & (np.abs((S - mean) @ nrm) <= tol)

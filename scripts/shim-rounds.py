@@ -22,9 +22,9 @@ number, and adds points for the next round:
     `proj` splits a subsegment among its edges at the projection of one of its other
     vertices, where that falls in the piece's middle (all but a fraction --margin, 0.1,
     at either end); `mid` splits its longest subsegment at the midpoint. A split is an
-    extra vertex of every polygon on the input edge. With --lens-after N such shims are treated as by `free` in the first N
-    rounds; with --fallback-mid, `proj` splits at the midpoint where no projection falls
-    inside.
+    extra vertex of every polygon on the input edge. With --lens-after N such shims are
+    treated as by `free` in the first N rounds; with --fallback-mid, `proj` splits at the
+    midpoint where no projection falls inside.
 
 --presplit splits, before the first round, every input edge that meets another at one
 of the given apexes at under --fan-degrees (8) on the radii 2^(k/N) (N from
@@ -103,23 +103,18 @@ class Model:
         k = int(np.argmin(dist))
         return (k, float(t[k])) if dist[k] < 1e-9 * self.diag else None
 
-    def presplit(self, apexes, per_doubling, r_from, fan_degrees, phase):
-        at = {}
-        for k, (a, b) in enumerate(self.edges):
-            at.setdefault(a, []).append(k)
-            at.setdefault(b, []).append(k)
+    def fan_edges(self, apex, fan_degrees):
+        """The input edges at `apex` that meet another edge there at under `fan_degrees`."""
+        ks = [k for k, e in enumerate(self.edges) if apex in e]
+        unit = {}
+        for k in ks:
+            d = self.pts[sum(self.edges[k]) - apex] - self.pts[apex]
+            unit[k] = d / np.linalg.norm(d)
         cos_max = math.cos(math.radians(fan_degrees))
-        apex_of = {}
-        for x in apexes:
-            ks = at.get(x, [])
-            for i in ks:
-                for j in ks:
-                    if i == j:
-                        continue
-                    di = self.pts[sum(self.edges[i]) - x] - self.pts[x]
-                    dj = self.pts[sum(self.edges[j]) - x] - self.pts[x]
-                    if di @ dj / np.linalg.norm(di) / np.linalg.norm(dj) > cos_max:
-                        apex_of[i] = x
+        return {i for i in ks for j in ks if i != j and unit[i] @ unit[j] > cos_max}
+
+    def presplit(self, apexes, per_doubling, r_from, fan_degrees, phase):
+        apex_of = {k: x for x in apexes for k in sorted(self.fan_edges(x, fan_degrees))}
         rng = np.random.default_rng(0)
         for k, x in sorted(apex_of.items()):
             a, b = self.edges[k]
