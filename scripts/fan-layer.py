@@ -6,7 +6,7 @@ usage: scripts/fan-layer.py MODEL.off WORK_DIR --apexes A,B,... [--ring-c C] [--
            [--height-factor F] [--skip-encroaching K] [--no-free] [--flags FLAGS]
            [--bin PATH] [--tools DIR]
 
-The eighteenth round's experiment on attene_cdt/112544.off (see the README). At each
+The eighteenth round's experiment on attene_cdt/112544.off (see docs/112544.md). At each
 apex, the input edges that meet another edge there at under 8 degrees (the spokes of a
 fan of needle triangles) are split on the same radii, r0 and then r + C*sqrt(r) (C from
 --ring-c, 0.004; r0 from --r0, 0.01), so that the pieces of neighbouring spokes form

@@ -16,8 +16,8 @@ This script finds the same shims and sorts each vertex into one of three kinds:
 
 It prints how many shims there are of each composition, then the heights of the
 foreign vertices above the group's plane as fractions of the slab's half-thickness.
-With --list it also prints every shim. The README's figures on attene_cdt/112544.off
-come from this script. It needs numpy.
+With --list it also prints every shim. The figures on attene_cdt/112544.off in
+docs/112544.md come from this script. It needs numpy.
 """
 import os
 import sys

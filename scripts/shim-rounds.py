@@ -6,7 +6,7 @@ usage: scripts/shim-rounds.py MODEL.off ROUNDS [--lens free|proj|mid] [--lens-af
            [--presplit APEX,APEX,... [--per-doubling N] [--from R] [--phase] [--fan-degrees D]]
            [--bin PATH] [--tools DIR] [--work DIR]
 
-The experiments of the README's 112544.off paragraphs. Each round writes the model as
+The experiments on 112544.off in docs/112544.md. Each round writes the model as
 a .poly (WORK/cur.poly; every triangle a facet) with the points added so far, meshes it
 with `tetcdt -pQ` (WORK/out.*), finds the shims that validate_mesh.py would count
 against the original MODEL.off (with scripts/shim-report.py's search), prints their
