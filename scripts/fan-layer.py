@@ -3,23 +3,29 @@
 shims the referee counts.
 
 usage: scripts/fan-layer.py MODEL.off WORK_DIR --apexes A,B,... [--ring-c C] [--r0 R0]
-           [--height-factor F] [--skip-encroaching K] [--no-free] [--flags FLAGS]
-           [--bin PATH] [--tools DIR]
+           [--height-factor F] [--skip-encroaching K] [--tall-apex T] [--no-free]
+           [--flags FLAGS] [--bin PATH] [--tools DIR]
 
-The eighteenth round's experiment on attene_cdt/112544.off (see docs/112544.md). At each
-apex, the input edges that meet another edge there at under 8 degrees (the spokes of a
-fan of needle triangles) are split on the same radii, r0 and then r + C*sqrt(r) (C from
---ring-c, 0.004; r0 from --r0, 0.01), so that the pieces of neighbouring spokes form
-isosceles trapezoids (cocircular, so the flat tets folded over a spoke have their
-circumspheres centred near the surface, not far beyond it). Every cell between two
-spokes of a fan triangle then gets a free point (an isolated node of the .poly) above
-its centre, on the domain's side, at F (--height-factor, 1.5) times the largest slab
-half-thickness the referee gives the merged facets at the apex: inside the folded tets'
-circumspheres, outside every slab. With --skip-encroaching K, a cell gets no point when
-its spoke pieces could no longer be Delaunay edges with the point in: when a sphere
-through a piece's ends must lie deeper than K times the spokes' distance apart there to
-leave the point out (that depth is (p^2/4 - h^2)/(2h) for a piece p long and a point h
-high).
+The experiment of the eighteenth and nineteenth rounds on attene_cdt/112544.off (see
+docs/112544.md). At each apex, the input edges that meet another edge there at under 8
+degrees (the spokes of a fan of needle triangles) are split on the same radii, r0 and then
+r + C*sqrt(r) (C from --ring-c, 0.004; r0 from --r0, 0.01), so that the pieces of
+neighbouring spokes form isosceles trapezoids (cocircular, so the flat tets folded over a
+spoke have their circumspheres centred near the surface, not far beyond it). Every cell
+between two spokes of a fan triangle then gets a free point (an isolated node of the
+.poly) above its centre, on the domain's side, at F (--height-factor, 1.5) times the
+largest slab half-thickness the referee gives the merged facets at the apex: inside the
+folded tets' circumspheres, outside every slab. With --skip-encroaching K, a cell gets no
+point when its spoke pieces could no longer be Delaunay edges with the point in: when a
+sphere through a piece's ends must lie deeper than K times the spokes' distance apart
+there to leave the point out (that depth is (p^2/4 - h^2)/(2h) for a piece p long and a
+point h high).
+
+With --tall-apex T, the needle cells at the apex (between the apex and the first ring)
+get their points anyway, but higher: at T * r0 / 2 (T a little over 1 puts the point
+just outside the diametral sphere of the spoke pieces beside it), or higher still if the
+sphere through the cell's circle and the point would otherwise hold a point of another
+spoke. A cell gets none when no height keeps every such point out.
 
 It writes WORK_DIR/cur.poly (every triangle a facet), meshes it with FLAGS (default
 `-pQM`) into WORK_DIR/out, and prints the shims by merged facet and by distance from the
@@ -112,7 +118,41 @@ def fan_edges(model, apex):
     return fan
 
 
-def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
+def circle(a, b, c):
+    """Centre and squared radius of the circle through three points."""
+    ab, ac = b - a, c - a
+    w = np.cross(ab, ac)
+    centre = a + (np.cross(w, ab) * (ac @ ac) + np.cross(ac, w) * (ab @ ab)) / (2 * (w @ w))
+    return centre, float((a - centre) @ (a - centre))
+
+
+def heights(corners, m, up, others):
+    """The heights h at which the sphere through the circle of `corners` and the point
+    m + h * up leaves every point of `others` out: (lowest, highest), or None.
+
+    The sphere's centre lies t = (h^2 + d^2 - R^2) / (2h) along `up` from the circle's
+    centre (d: m's distance from it), which grows with h. A point at z along `up` and
+    s^2 from the circle's centre is out when s^2 - R^2 >= 2 t z, which bounds t from
+    above for points on the `up` side and from below for the others."""
+    centre, r2 = circle(*corners)
+    d2 = float((m - centre) @ (m - centre))
+    near = others[np.sum((others - centre) ** 2, axis=1) < 9 * r2]
+    s = np.sum((near - centre) ** 2, axis=1) - r2
+    z = (near - centre) @ up
+    if np.any((z == 0) & (s < 0)):
+        return None
+    t_hi = float(np.min(s[z > 0] / (2 * z[z > 0]))) if (z > 0).any() else math.inf
+    t_lo = float(np.max(s[z < 0] / (2 * z[z < 0]))) if (z < 0).any() else -math.inf
+    if t_lo > t_hi:
+        return None
+
+    def h(t):
+        return t + math.sqrt(t * t + r2 - d2)
+
+    return (h(t_lo) if t_lo > -math.inf else 0.0), (h(t_hi) if t_hi < math.inf else math.inf)
+
+
+def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall):
     """Splits the fan's spokes on shared rings and returns the free points above its cells."""
     fan = fan_edges(model, apex)
     if not fan:
@@ -124,6 +164,9 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
     for k, (_, length) in fan.items():
         a, _b = model.edges[k]
         model.splits[k] = [r / length if a == apex else 1 - r / length for r in radii if r < 0.98 * length]
+    top = model.pts[apex]
+    ring = np.array(radii)
+    on_spoke = {k: top + np.outer(ring[ring < 0.98 * length], d) for k, (d, length) in fan.items()}
     polys = [i for i, p in enumerate(model.polys) if apex in p]
     height = factor * max(tol[i] for i in polys)
     points = []
@@ -140,16 +183,23 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip):
         n /= np.linalg.norm(n)
         angle = math.acos(min(1.0, float(du @ dv)))
         rr = [0.0] + [r for r in radii if r < 0.98 * min(lu, lv)]
+        others = np.concatenate([on_spoke[k] for k in fan if k not in ks] + [np.zeros((0, 3))])
         side = None
         for r1, r2 in zip(rr, rr[1:]):
             piece, apart = r2 - r1, angle * (r1 + r2) / 2
-            if skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
-                continue
-            m = model.pts[apex] + (du + dv) / 2 * (r1 + r2) / 2
+            m = top + (du + dv) / 2 * (r1 + r2) / 2
             if side is None:
                 side = 1.0 if surface.inside(m + n * height) else -1.0
-            x = m + side * n * height
-            if surface.distance(x, 2 * height) >= 0.9 * height and surface.inside(x):
+            h = height
+            if tall and r1 == 0:
+                span = heights([top, top + du * r2, top + dv * r2], m, side * n, others)
+                if span is None or max(span[0], tall * r2 / 2) > span[1]:
+                    continue
+                h = max(span[0], tall * r2 / 2, height)
+            elif skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
+                continue
+            x = m + side * n * h
+            if surface.distance(x, 2 * h) >= 0.9 * height and surface.inside(x):
                 points.append(x.tolist())
     return len(fan), len(radii), points
 
@@ -159,7 +209,8 @@ def main(argv):
     option = shim_rounds.option
     report = shim_rounds.load_report()
     vm = report.load_referee(argv)
-    valued = {"--apexes", "--ring-c", "--r0", "--height-factor", "--skip-encroaching", "--flags", "--bin", "--tools"}
+    valued = {"--apexes", "--ring-c", "--r0", "--height-factor", "--skip-encroaching", "--tall-apex", "--flags",
+              "--bin", "--tools"}
     args = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in valued)]
     if len(args) != 2 or not args[0].endswith(".off") or "--apexes" not in argv:
         sys.exit(__doc__)
@@ -169,6 +220,7 @@ def main(argv):
     r0 = float(option(argv, "--r0", "0.01"))
     factor = float(option(argv, "--height-factor", "1.5"))
     skip = float(option(argv, "--skip-encroaching", "0"))
+    tall = float(option(argv, "--tall-apex", "0"))
     flags = option(argv, "--flags", "-pQM").split()
     binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
     os.makedirs(work, exist_ok=True)
@@ -176,7 +228,7 @@ def main(argv):
     tol = slabs(vm, report, model)
     surface = Surface(model)
     for apex in apexes:
-        edges, rings, points = layer(model, surface, tol, apex, ring_c, r0, factor, skip)
+        edges, rings, points = layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall)
         if "--no-free" not in argv:
             model.free.extend(points)
         print(f"apex {apex}: {edges} spokes, {rings} rings, {len(points)} free points", flush=True)
