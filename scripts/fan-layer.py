@@ -128,21 +128,23 @@ def circle(a, b, c):
 
 def heights(corners, m, up, others):
     """The heights h at which the sphere through the circle of `corners` and the point
-    m + h * up leaves every point of `others` out: (lowest, highest), or None.
+    m + h * up leaves out every point of `others` within three radii of the circle's
+    centre (the spheres wanted are not much larger than the circle): (lowest, highest),
+    or None.
 
     The sphere's centre lies t = (h^2 + d^2 - R^2) / (2h) along `up` from the circle's
-    centre (d: m's distance from it), which grows with h. A point at z along `up` and
-    s^2 from the circle's centre is out when s^2 - R^2 >= 2 t z, which bounds t from
-    above for points on the `up` side and from below for the others."""
+    centre (d: m's distance from it), which grows with h. A point at z along `up`, and
+    at squared distance R^2 + e from the circle's centre, is out when e >= 2 t z: that
+    bounds t from above for points on the `up` side and from below for the others."""
     centre, r2 = circle(*corners)
     d2 = float((m - centre) @ (m - centre))
     near = others[np.sum((others - centre) ** 2, axis=1) < 9 * r2]
-    s = np.sum((near - centre) ** 2, axis=1) - r2
+    e = np.sum((near - centre) ** 2, axis=1) - r2
     z = (near - centre) @ up
-    if np.any((z == 0) & (s < 0)):
+    if np.any((z == 0) & (e < 0)):
         return None
-    t_hi = float(np.min(s[z > 0] / (2 * z[z > 0]))) if (z > 0).any() else math.inf
-    t_lo = float(np.max(s[z < 0] / (2 * z[z < 0]))) if (z < 0).any() else -math.inf
+    t_hi = float(np.min(e[z > 0] / (2 * z[z > 0]))) if (z > 0).any() else math.inf
+    t_lo = float(np.max(e[z < 0] / (2 * z[z < 0]))) if (z < 0).any() else -math.inf
     if t_lo > t_hi:
         return None
 
