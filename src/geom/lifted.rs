@@ -19,7 +19,7 @@ use std::cmp::Ordering;
 
 /// A floating-point value with its permanent (the same expression evaluated on absolute
 /// values). An expression tree of depth d evaluated from exact inputs is off by at most
-/// γ_d times the permanent; all ours have depth at most 12 ([`ERR`]).
+/// γ_d times the permanent; all ours have depth at most 12 (hence the module's bound `ERR`).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct Approx {
     /// The value, rounded.
