@@ -3,8 +3,8 @@
 shims the referee counts.
 
 usage: scripts/fan-layer.py MODEL.off WORK_DIR --apexes A,B,... [--ring-c C] [--r0 R0]
-           [--height-factor F] [--skip-encroaching K] [--tall-apex T] [--no-free]
-           [--flags FLAGS] [--bin PATH] [--tools DIR]
+           [--height-factor F] [--skip-encroaching K] [--tall-apex T] [--fit-heights]
+           [--off-slabs] [--no-free] [--flags FLAGS] [--bin PATH] [--tools DIR]
 
 The experiment of the eighteenth and nineteenth rounds on attene_cdt/112544.off (see
 docs/112544.md). At each apex, the input edges that meet another edge there at under 8
@@ -25,7 +25,15 @@ With --tall-apex T, the needle cells at the apex (between the apex and the first
 get their points anyway, but higher: at T * r0 / 2 (T a little over 1 puts the point
 just outside the diametral sphere of the spoke pieces beside it), or higher still if the
 sphere through the cell's circle and the point would otherwise hold a point of another
-spoke. A cell gets none when no height keeps every such point out.
+spoke. A cell gets none when no height keeps every such point out. With --fit-heights,
+the other cells are held to the same test: a cell's point goes at F slabs, or at 1.25
+times the lowest admissible height if that is higher (halfway to the highest if 1.25
+times is too high), and a cell whose admissible heights all lie below F slabs gets none.
+
+The points keep their distance from the surface, but a point can still lie in the slab
+of a merged facet elsewhere, within that facet's box, where the referee counts it as a
+vertex of the facet (at an apex whose fan is not flat, points above one triangle can
+lie in another's plane). With --off-slabs such points are dropped.
 
 It writes WORK_DIR/cur.poly (every triangle a facet), meshes it with FLAGS (default
 `-pQM`) into WORK_DIR/out, and prints the shims by merged facet and by distance from the
@@ -50,14 +58,26 @@ def load(name, file):
     return mod
 
 
-def slabs(vm, report, model):
-    """The referee's slab half-thickness of each polygon's merged facet."""
-    groups, _ = vm.merge_coplanar(model.pts, model.polys, model.facet_of)
-    tol = {}
-    for g in groups:
-        t = report.group_slab(vm, model.pts, [model.polys[i] for i in g], model.diag)[3]
-        tol.update((i, t) for i in g)
-    return tol
+class Slabs:
+    """The referee's slab of every merged facet. A Steiner point inside one, within the
+    facet's box, counts as lying on that facet."""
+
+    def __init__(self, vm, report, model):
+        groups, _ = vm.merge_coplanar(model.pts, model.polys, model.facet_of)
+        self.tol = {}  # polygon -> the slab half-thickness of its merged facet
+        rows = []
+        for g in groups:
+            nrm, own, mean, tol = report.group_slab(vm, model.pts, [model.polys[i] for i in g], model.diag)
+            self.tol.update((i, tol) for i in g)
+            q = model.pts[own]
+            rows.append((nrm, mean, tol, q.min(0) - tol, q.max(0) + tol))
+        self.nrm, self.mean, self.half, self.lo, self.hi = (np.array([r[k] for r in rows]) for k in range(5))
+
+    def holds(self, x):
+        """Whether the referee would count point `x` as lying on some merged facet."""
+        box = np.all((x >= self.lo) & (x <= self.hi), axis=1)
+        off = np.abs(np.einsum("ij,ij->i", x - self.mean[box], self.nrm[box]))
+        return bool((off <= self.half[box]).any())
 
 
 class Surface:
@@ -154,7 +174,7 @@ def heights(corners, m, up, others):
     return (h(t_lo) if t_lo > -math.inf else 0.0), (h(t_hi) if t_hi < math.inf else math.inf)
 
 
-def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall):
+def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall, fit, off_slabs):
     """Splits the fan's spokes on shared rings and returns the free points above its cells."""
     fan = fan_edges(model, apex)
     if not fan:
@@ -200,7 +220,17 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall):
                 h = max(span[0], tall * r2 / 2, height)
             elif skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
                 continue
+            elif fit:
+                corners = [top + du * r1, top + dv * r1, top + dv * r2]
+                span = heights(corners, m, side * n, others)
+                if span is None or span[1] < height:
+                    continue
+                h = max(height, 1.25 * span[0])
+                if h > span[1]:
+                    h = (max(height, span[0]) + span[1]) / 2
             x = m + side * n * h
+            if off_slabs is not None and off_slabs.holds(x):
+                continue
             if surface.distance(x, 2 * h) >= 0.9 * height and surface.inside(x):
                 points.append(x.tolist())
     return len(fan), len(radii), points
@@ -227,10 +257,11 @@ def main(argv):
     binary = option(argv, "--bin", os.path.join(HERE, "..", "target", "release", "tetcdt"))
     os.makedirs(work, exist_ok=True)
     model = shim_rounds.Model(vm, path)
-    tol = slabs(vm, report, model)
+    slabs = Slabs(vm, report, model)
     surface = Surface(model)
     for apex in apexes:
-        edges, rings, points = layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall)
+        edges, rings, points = layer(model, surface, slabs.tol, apex, ring_c, r0, factor, skip, tall,
+                                      "--fit-heights" in argv, slabs if "--off-slabs" in argv else None)
         if "--no-free" not in argv:
             model.free.extend(points)
         print(f"apex {apex}: {edges} spokes, {rings} rings, {len(points)} free points", flush=True)
