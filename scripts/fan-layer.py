@@ -221,7 +221,7 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall, fit, off_sl
             elif skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
                 continue
             elif fit:
-                corners = [top + du * r1, top + dv * r1, top + dv * r2]
+                corners = [top + du * r1 if r1 else top + du * r2, top + dv * r1, top + dv * r2]
                 span = heights(corners, m, side * n, others)
                 if span is None or span[1] < height:
                     continue
