@@ -205,29 +205,34 @@ def layer(model, surface, tol, apex, ring_c, r0, factor, skip, tall, fit, off_sl
         n /= np.linalg.norm(n)
         angle = math.acos(min(1.0, float(du @ dv)))
         rr = [0.0] + [r for r in radii if r < 0.98 * min(lu, lv)]
-        others = np.concatenate([on_spoke[k] for k in fan if k not in ks] + [np.zeros((0, 3))])
+        fitting = tall or fit
+        others = np.concatenate([on_spoke[k] for k in fan if k not in ks] + [np.zeros((0, 3))]) if fitting else None
         side = None
         for r1, r2 in zip(rr, rr[1:]):
             piece, apart = r2 - r1, angle * (r1 + r2) / 2
             m = top + (du + dv) / 2 * (r1 + r2) / 2
             if side is None:
                 side = 1.0 if surface.inside(m + n * height) else -1.0
-            h = height
-            if tall and r1 == 0:
-                span = heights([top, top + du * r2, top + dv * r2], m, side * n, others)
-                if span is None or max(span[0], tall * r2 / 2) > span[1]:
-                    continue
-                h = max(span[0], tall * r2 / 2, height)
-            elif skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
+            apex_cell = tall and r1 == 0
+            if not apex_cell and skip > 0 and (piece * piece / 4 - height * height) / (2 * height) > skip * apart:
                 continue
-            elif fit:
+            h = height
+            if apex_cell or fit:
                 corners = [top + du * r1 if r1 else top + du * r2, top + dv * r1, top + dv * r2]
                 span = heights(corners, m, side * n, others)
-                if span is None or span[1] < height:
+                if span is None:
                     continue
-                h = max(height, 1.25 * span[0])
-                if h > span[1]:
-                    h = (max(height, span[0]) + span[1]) / 2
+                lo, hi = span
+                if apex_cell:
+                    if max(lo, tall * r2 / 2) > hi:
+                        continue
+                    h = max(lo, tall * r2 / 2, height)
+                else:
+                    if hi < height:
+                        continue
+                    h = max(height, 1.25 * lo)
+                    if h > hi:
+                        h = (max(height, lo) + hi) / 2
             x = m + side * n * h
             if off_slabs is not None and off_slabs.holds(x):
                 continue
