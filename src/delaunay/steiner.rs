@@ -6,6 +6,9 @@ use crate::error::MeshError;
 use crate::geom::Point;
 use crate::mesh::{FaceRef, Tet, TetId, VertexId, GHOST};
 
+/// Marks an old tet's slot while [`Delaunay::undo`] restores a change.
+const RESTORED: u8 = 3;
+
 /// What [`Delaunay::insert_walled`] did.
 #[derive(Clone, Debug)]
 pub enum Walled {
@@ -135,21 +138,23 @@ impl Delaunay {
     /// `changes`, oldest first, the insertion's own first), restoring the mesh exactly;
     /// `last` is where point location started before.
     pub fn undo(&mut self, v: VertexId, changes: &[Change], last: TetId) {
-        let mut slots: Vec<TetId> = Vec::new();
+        if self.mark.len() < self.mesh.num_slots() {
+            self.mark.resize(self.mesh.num_slots(), 0);
+        }
         for c in changes.iter().rev() {
             // The new tets' slots go first: some are the old tets' own slots.
             for &t in &c.new {
                 self.mesh.kill_tet(t);
             }
+            // The old tets' slots are marked (the marks are clear between operations):
+            // a link to one of them needs no rewiring from the other side.
             for &(t, tet) in &c.old {
                 self.mesh.restore_tet(t, tet);
+                self.mark[t as usize] = RESTORED;
             }
-            slots.clear();
-            slots.extend(c.old.iter().map(|&(t, _)| t));
-            slots.sort_unstable();
             for &(t, tet) in &c.old {
                 for (f, &n) in tet.adj.iter().enumerate() {
-                    if slots.binary_search(&n.tet()).is_err() {
+                    if self.mark[n.tet() as usize] != RESTORED {
                         self.mesh.set_link(n, FaceRef::new(t, f));
                     }
                 }
@@ -158,6 +163,9 @@ impl Delaunay {
                         self.mesh.set_vertex_tet(x, t);
                     }
                 }
+            }
+            for &(t, _) in &c.old {
+                self.mark[t as usize] = 0;
             }
         }
         self.created.clear();

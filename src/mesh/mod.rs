@@ -314,7 +314,11 @@ impl Mesh {
     /// Frees tet `t`. Its neighbours' links to it must be rewired by the caller.
     #[inline]
     pub fn kill_tet(&mut self, t: TetId) {
-        self.tets[t as usize].v[0] = DEAD;
+        let slot = &mut self.tets[t as usize];
+        slot.v[0] = DEAD;
+        // A free slot keeps its place in the free list, so that restoring it is O(1):
+        // undoing a large cavity restores every one of its tets.
+        slot.v[1] = self.free.len() as VertexId;
         self.free.push(t);
     }
 
@@ -322,8 +326,17 @@ impl Mesh {
     /// free list if it was freed (undoing an insertion).
     pub fn restore_tet(&mut self, t: TetId, tet: Tet) {
         if self.tets[t as usize].v[0] == DEAD {
-            if let Some(k) = self.free.iter().rposition(|&x| x == t) {
+            let k = self.tets[t as usize].v[1] as usize;
+            let k = if self.free.get(k) == Some(&t) {
+                Some(k)
+            } else {
+                self.free.iter().rposition(|&x| x == t)
+            };
+            if let Some(k) = k {
                 self.free.swap_remove(k);
+                if let Some(&moved) = self.free.get(k) {
+                    self.tets[moved as usize].v[1] = k as VertexId;
+                }
             }
         }
         self.tets[t as usize] = tet;
@@ -501,6 +514,41 @@ mod tests {
         assert_eq!(f.tet(), t);
         assert_eq!(f.face(), 3);
         assert!(f.0 as usize > (1usize << 31));
+    }
+
+    /// Every free slot records its place in the free list.
+    fn free_places_hold(m: &Mesh) {
+        for (k, &t) in m.free.iter().enumerate() {
+            assert_eq!(m.tets[t as usize].v[0], DEAD);
+            assert_eq!(m.tets[t as usize].v[1] as usize, k, "slot {t}");
+        }
+    }
+
+    #[test]
+    fn restoring_slots_keeps_the_free_list_in_order() {
+        let mut m = Mesh::new(8);
+        let ts: Vec<TetId> = (0..6)
+            .map(|i| m.add_tet([i, i + 1, i + 2, 7]).unwrap())
+            .collect();
+        let saved: Vec<Tet> = ts.iter().map(|&t| *m.tet(t)).collect();
+        for &t in &ts {
+            m.kill_tet(t);
+        }
+        free_places_hold(&m);
+        // Restoring from the middle moves the last free slot into the gap, as a
+        // swap_remove does; the moved slot's place is updated with it.
+        for &k in &[1usize, 4, 0] {
+            m.restore_tet(ts[k], saved[k]);
+            assert!(m.is_alive(ts[k]));
+            free_places_hold(&m);
+        }
+        assert_eq!(m.free, vec![ts[3], ts[5], ts[2]]);
+        // Slots are reused from the end of the list.
+        assert_eq!(m.add_tet([0, 1, 2, 3]).unwrap(), ts[2]);
+        m.kill_tet(ts[2]);
+        m.restore_tet(ts[2], saved[2]);
+        free_places_hold(&m);
+        assert_eq!(m.free, vec![ts[3], ts[5]]);
     }
 
     #[test]
