@@ -506,6 +506,22 @@ fn remover(
     } else {
         &[0.95, 0.8, 0.5, 0.3, 0.15, 0.05, 0.0]
     };
+    // Every candidate lies within this box (the directions are unit vectors, with room
+    // for rounding): only the slabs whose boxes meet it can hold one. A model has
+    // thousands of facets, and a tet hundreds of candidates.
+    let reach = 1.001 * fracs[0] * bases.iter().map(|&(_, s)| s).fold(0.0, f64::max);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (b, _) in &bases {
+        for k in 0..3 {
+            lo[k] = lo[k].min(b[k] - reach);
+            hi[k] = hi[k].max(b[k] + reach);
+        }
+    }
+    let near: Vec<&Slab> = slabs
+        .iter()
+        .flatten()
+        .filter(|s| (0..3).all(|k| s.lo[k] - s.tol <= hi[k] && s.hi[k] + s.tol >= lo[k]))
+        .collect();
     for strict in [true, false] {
         for &frac in fracs {
             for &(b, scale) in &bases {
@@ -514,7 +530,7 @@ fn remover(
                     // Off every facet's slab (near one it could form flat tets there),
                     // or, failing that, off the tet's own.
                     let off = if strict {
-                        !slabs.iter().flatten().any(|s| s.holds(&w))
+                        !near.iter().any(|s| s.holds(&w))
                     } else {
                         !slab.holds(&w)
                     };
