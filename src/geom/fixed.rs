@@ -58,7 +58,7 @@ impl I320 {
         let m = self.abs().0;
         let mut x = 0.0f64;
         for (i, &l) in m.iter().enumerate().rev() {
-            x += l as f64 * 2f64.powi(64 * i as i32);
+            x += l as f64 * super::pow2(64 * i as i32);
         }
         let y = times_pow2(x, scale);
         if negative {
@@ -148,14 +148,14 @@ const SPAN_BITS: i32 = 58;
 fn times_pow2(x: f64, e: i32) -> f64 {
     let (mut y, mut e) = (x, e);
     while e > 1000 {
-        y *= 2f64.powi(1000);
+        y *= super::pow2(1000);
         e -= 1000;
     }
     while e < -1000 {
-        y *= 2f64.powi(-1000);
+        y *= super::pow2(-1000);
         e += 1000;
     }
-    y * 2f64.powi(e)
+    y * super::pow2(e)
 }
 
 /// The coordinates as integers in units of their common lowest set bit `2^lo`, with

@@ -30,6 +30,17 @@ pub fn dot(a: &Point, b: &Point) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// `2^e`, exactly: built from its bits in the normal range, where `powi` would call a
+/// runtime routine (hot in the fixed-point predicates); `powi` elsewhere.
+#[inline]
+pub fn pow2(e: i32) -> f64 {
+    if (-1022..=1023).contains(&e) {
+        f64::from_bits(((e + 1023) as u64) << 52)
+    } else {
+        2f64.powi(e)
+    }
+}
+
 /// A deterministic pseudo-random number in [0, 1) (an LCG), for tests.
 #[cfg(test)]
 pub(crate) fn lcg(s: &mut u64) -> f64 {
@@ -50,4 +61,14 @@ pub fn bounding_box(points: &[Point]) -> [Point; 2] {
         }
     }
     [lo, hi]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn pow2_is_powi_bit_for_bit() {
+        for e in -1100..=1100 {
+            assert_eq!(super::pow2(e).to_bits(), 2f64.powi(e).to_bits(), "2^{e}");
+        }
+    }
 }

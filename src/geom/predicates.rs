@@ -181,7 +181,7 @@ fn insphere_small_integers(a: &Point, b: &Point, c_: &Point, d: &Point, e: &Poin
     if hi - lo >= 23 {
         return None;
     }
-    let scale = 2f64.powi(-lo);
+    let scale = super::pow2(-lo);
     let n: [[i128; 3]; 4] =
         std::array::from_fn(|i| std::array::from_fn(|k| (diff[i][k] * scale) as i128));
     Some(-(insphere_rows(n).signum() as f64))
