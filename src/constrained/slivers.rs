@@ -481,12 +481,32 @@ fn remover(
         bases.push((c, r));
         bases.push((h, r));
     }
+    let fracs: &[f64] = if flat {
+        &[0.5, 0.3, 0.15, 0.05, 0.0]
+    } else {
+        &[0.95, 0.8, 0.5, 0.3, 0.15, 0.05, 0.0]
+    };
+    // Every candidate lies within this box (the directions are unit vectors, with room
+    // for rounding), and so does the centroid: only the slabs whose boxes meet it can
+    // hold one. A model has thousands of facets, and a tet hundreds of candidates.
+    let reach = 1.001 * fracs[0] * bases.iter().map(|&(_, s)| s).fold(0.0, f64::max);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for (b, _) in &bases {
+        for k in 0..3 {
+            lo[k] = lo[k].min(b[k] - reach);
+            hi[k] = hi[k].max(b[k] + reach);
+        }
+    }
+    let near: Vec<&Slab> = slabs
+        .iter()
+        .flatten()
+        .filter(|s| (0..3).all(|k| s.lo[k] - s.tol <= hi[k] && s.hi[k] + s.tol >= lo[k]))
+        .collect();
     // Along an edge where facets meet, the point must leave all their slabs at once:
     // the facet's normal, each other facet's there, and their sums and differences.
     let mut dirs: Vec<Point> = vec![slab.normal];
-    for n in slabs
+    for n in near
         .iter()
-        .flatten()
         .filter(|s| s.holds(&m))
         .map(|s| s.normal)
         .take(6)
@@ -501,27 +521,6 @@ fn remover(
         dirs.push(n);
     }
     let inside = |w: &Point| insphere(&p[0], &p[1], &p[2], &p[3], w) * o.signum() > 0.0;
-    let fracs: &[f64] = if flat {
-        &[0.5, 0.3, 0.15, 0.05, 0.0]
-    } else {
-        &[0.95, 0.8, 0.5, 0.3, 0.15, 0.05, 0.0]
-    };
-    // Every candidate lies within this box (the directions are unit vectors, with room
-    // for rounding): only the slabs whose boxes meet it can hold one. A model has
-    // thousands of facets, and a tet hundreds of candidates.
-    let reach = 1.001 * fracs[0] * bases.iter().map(|&(_, s)| s).fold(0.0, f64::max);
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for (b, _) in &bases {
-        for k in 0..3 {
-            lo[k] = lo[k].min(b[k] - reach);
-            hi[k] = hi[k].max(b[k] + reach);
-        }
-    }
-    let near: Vec<&Slab> = slabs
-        .iter()
-        .flatten()
-        .filter(|s| (0..3).all(|k| s.lo[k] - s.tol <= hi[k] && s.hi[k] + s.tol >= lo[k]))
-        .collect();
     for strict in [true, false] {
         for &frac in fracs {
             for &(b, scale) in &bases {
