@@ -14,7 +14,7 @@ use crate::geom::{cross, dot, sub, Point};
 use crate::mesh::VertexId;
 use crate::plc::Region;
 use rustc_hash::FxHashMap;
-use std::cell::{OnceCell, RefCell};
+use std::cell::OnceCell;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
 /// referee's measure (1e-3) with a margin, so that what we remove is what it flags.
@@ -58,41 +58,50 @@ pub(crate) struct Search<'a> {
     pub seg_ends: FxHashMap<VertexId, [u32; 2]>,
     pub domain: Domain<'a>,
     /// Which facets each input vertex is on, and the facets' slabs: made when first
-    /// needed.
+    /// needed (a model without Steiner points never needs them).
     pub index: OnceCell<FacetIndex>,
 }
 
-/// Which facets each input vertex is on, and the facets' slabs, built on demand (most
-/// facets never hold a tet of their own vertices).
+/// Which facets each input vertex is on, and the facets' slabs.
 pub(crate) struct FacetIndex {
     on_facets: crate::mesh::VertexLists<u32>,
-    slabs: RefCell<Vec<Option<Option<Slab>>>>,
-    diag: f64,
+    slabs: Vec<Option<Slab>>,
+    /// The thickest slab's half-thickness: a tet thicker than twice it lies in none.
+    tol_max: f64,
 }
 
 impl Search<'_> {
     fn index(&self) -> &FacetIndex {
-        self.index.get_or_init(|| FacetIndex {
-            on_facets: crate::mesh::VertexLists::new(
-                self.input.len(),
-                self.prep
-                    .facets
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, f)| f.normal != [0.0; 3])
-                    .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
-            ),
-            slabs: RefCell::new(vec![None; self.prep.facets.len()]),
-            diag: diagonal(self.input),
+        self.index.get_or_init(|| {
+            let diag = diagonal(self.input);
+            let slabs: Vec<Option<Slab>> = (0..self.prep.facets.len())
+                .map(|fi| slab_of(self.prep, self.input, diag, fi))
+                .collect();
+            FacetIndex {
+                on_facets: crate::mesh::VertexLists::new(
+                    self.input.len(),
+                    self.prep
+                        .facets
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, f)| f.normal != [0.0; 3])
+                        .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
+                ),
+                tol_max: slabs.iter().flatten().map(|s| s.tol).fold(0.0, f64::max),
+                slabs,
+            }
         })
     }
 
     /// Facet `fi`'s slab, if it has one.
-    fn slab(&self, fi: usize) -> Option<Slab> {
-        let index = self.index();
-        index.slabs.borrow_mut()[fi]
-            .get_or_insert_with(|| slab_of(self.prep, self.input, index.diag, fi))
-            .clone()
+    fn slab(&self, fi: usize) -> Option<&Slab> {
+        self.index().slabs[fi].as_ref()
+    }
+
+    /// Whether the tet is thin enough to lie in some facet's slab (see
+    /// [`may_lie_in_slab`]): most tets are not, and this is cheaper than asking each facet.
+    fn may_lie_in_a_slab(&self, p: &[Point; 4]) -> bool {
+        may_lie_in_slab(p, self.index().tol_max)
     }
 
     /// The facet that the tet's four vertices all lie on, if any: input vertices by the
@@ -263,8 +272,12 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
         .filter(|&t| !cdt.is_ghost(t) && candidate(cdt.dt.mesh.verts(t)))
         .filter_map(|t| {
             let v = cdt.dt.mesh.verts(t);
+            let p = v.map(|x| cdt.dt.points[x as usize]);
+            if !search.may_lie_in_a_slab(&p) {
+                return None;
+            }
             let f = search.facet_of(cdt, v)?;
-            Some((t, f, is_flat(&v.map(|x| cdt.dt.points[x as usize]))))
+            Some((t, f, is_flat(&p)))
         })
         .collect();
     if tets.is_empty() {
@@ -323,9 +336,7 @@ pub(crate) fn free_points(
         return FlatTets::default();
     };
     // A free point is sought off every facet's slab first: all are needed from here on.
-    let slabs: Vec<Option<Slab>> = (0..search.prep.facets.len())
-        .map(|fi| search.slab(fi))
-        .collect();
+    let slabs = &search.index().slabs;
     let mut out = FlatTets {
         found: (tets.len(), tets.first().map(|x| x.1)),
         ..Default::default()
@@ -335,7 +346,7 @@ pub(crate) fn free_points(
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        let ws = remover(cdt, &kept, t, &p, flat, slab, &slabs);
+        let ws = remover(cdt, &kept, t, &p, flat, slab, slabs);
         // A flat tet with no point off every slab may still be split (see `mod.rs`)
         // if the checked points fail.
         if flat && ws.first().is_none_or(|c| c.checked) {
@@ -431,6 +442,28 @@ fn slab_of(prep: &PreparedPlc, input: &[Point], diag: f64, fi: usize) -> Option<
     }
     slab.tol = (1e-10 * diag).max(4.0 * dev);
     Some(slab)
+}
+
+/// Whether the tet may lie in a slab of half-thickness `tol`. A tet between two planes
+/// `w` apart has at most `2 w` times its largest face's area as volume (its
+/// cross-sections are no larger than its shadow, which its faces cover twice), so within
+/// the slab `|det| <= 24 tol A_max`; twice that allows for rounding.
+fn may_lie_in_slab(p: &[Point; 4], tol: f64) -> bool {
+    let d: [Point; 3] = std::array::from_fn(|i| sub(&p[i + 1], &p[0]));
+    let det = dot(&d[0], &cross(&d[1], &d[2]));
+    let (e, f) = (sub(&p[2], &p[1]), sub(&p[3], &p[1]));
+    // Each |cross| is twice a face's area.
+    let largest2 = [
+        cross(&d[0], &d[1]),
+        cross(&d[1], &d[2]),
+        cross(&d[2], &d[0]),
+        cross(&e, &f),
+    ]
+    .iter()
+    .map(|n| dot(n, n))
+    .fold(0.0, f64::max);
+    let bound = 24.0 * tol;
+    det * det <= bound * bound * largest2 || !det.is_finite()
 }
 
 /// Whether the tet is flat by the [`FLAT`] measure.
@@ -587,4 +620,61 @@ fn longest_edge2(p: &[Point; 4]) -> f64 {
         .iter()
         .map(|&(i, j)| (0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum::<f64>())
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (no dependency for one test).
+    fn lcg(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn tets_in_a_slab_pass_the_thinness_bound_and_thick_ones_do_not() {
+        let mut st = 7u64;
+        // A tilted slab: unit normal n, half-thickness tol, through the origin.
+        let n = [0.36, 0.48, 0.8];
+        let (u, v) = ([0.8, -0.6, 0.0], [0.48, 0.64, -0.6]);
+        for tol in [1e-10, 1e-6, 1e-3] {
+            for _ in 0..2000 {
+                let p: [Point; 4] = std::array::from_fn(|_| {
+                    let (a, b, h) = (lcg(&mut st) - 0.5, lcg(&mut st) - 0.5, lcg(&mut st));
+                    // Heights at the slab's faces too, the worst case.
+                    let h = tol
+                        * if h < 0.2 {
+                            -1.0
+                        } else if h > 0.8 {
+                            1.0
+                        } else {
+                            2.0 * h - 1.0
+                        };
+                    std::array::from_fn(|k| a * u[k] + b * v[k] + h * n[k])
+                });
+                assert!(may_lie_in_slab(&p, tol), "{p:?} {tol}");
+            }
+        }
+        // A sliver across the slab, two vertices on each face: |det| is 4 tol |cross|.
+        for tol in [1e-9, 1e-3] {
+            let sliver = [
+                [1.0, 0.0, tol],
+                [-1.0, 0.0, tol],
+                [0.0, 1.0, -tol],
+                [0.0, -1.0, -tol],
+            ];
+            assert!(may_lie_in_slab(&sliver, tol));
+        }
+        let regular = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ];
+        assert!(!may_lie_in_slab(&regular, 0.01));
+        assert!(may_lie_in_slab(&regular, 1.0));
+    }
 }
