@@ -140,6 +140,8 @@ pub fn recover_segments(
                     dt.orig[a as usize], dt.orig[b as usize]
                 )));
             }
+            // The walk to the point starts at its piece's end: it lies on the piece.
+            dt.start_walk_at(pc.u);
             let Some(w) = dt.insert_steiner_noting(x, *next_pert, Some(&mut cavity.removed))?
             else {
                 return Err(MeshError::InvalidPlc(format!(

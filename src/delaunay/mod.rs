@@ -535,7 +535,10 @@ impl Delaunay {
     /// filling such a cavity would glue the new tets wrongly.
     pub(crate) fn boundary_is_a_sphere(&self) -> bool {
         let mut directed: rustc_hash::FxHashSet<(VertexId, VertexId)> =
-            rustc_hash::FxHashSet::default();
+            rustc_hash::FxHashSet::with_capacity_and_hasher(
+                3 * self.boundary.len(),
+                Default::default(),
+            );
         for b in &self.boundary {
             for (_, (x, y)) in FAN_EDGES[b.face] {
                 if !directed.insert((b.v[x], b.v[y])) {

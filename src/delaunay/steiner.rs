@@ -67,6 +67,16 @@ impl Delaunay {
         Ok(Some(v))
     }
 
+    /// Makes the next point location walk from a tet of vertex `v` (a real one), for a
+    /// point known to lie near `v`.
+    pub fn start_walk_at(&mut self, v: VertexId) {
+        if let Some(t) = self.mesh.vertex_tet(v) {
+            if self.mesh.is_alive(t) && !self.mesh.is_ghost(t) {
+                self.last = t;
+            }
+        }
+    }
+
     /// Appends point `p` with perturbation index `pert`; its vertex id.
     fn push_point(&mut self, p: Point, pert: u32) -> VertexId {
         let v = self.points.len() as VertexId;

@@ -397,3 +397,43 @@ fn walled_cavities_not_seen_whole_from_the_point_are_refused() {
         "{refused} refused, {inserted} inserted"
     );
 }
+
+/// Where the walk starts changes how far it goes, never the tetrahedralization: Steiner
+/// points inserted with the walk started at a vertex near each (as segment recovery
+/// does) give the same tets as with the walk started wherever the last insertion ended.
+#[test]
+fn walks_started_at_a_vertex_insert_the_same_points() {
+    let pts = random_points(400, 5);
+    let mut plain = Delaunay::build(&pts).unwrap().dt;
+    let mut hinted = Delaunay::build(&pts).unwrap().dt;
+    let mut s = 99u64;
+    for k in 0..200 {
+        let v = (lcg(&mut s) * pts.len() as f64) as usize % pts.len();
+        let w = (v + 1 + k) % pts.len();
+        // A point on the way from one input point to another, as on a segment.
+        let t = 0.1 + 0.8 * lcg(&mut s);
+        let x: Point = std::array::from_fn(|d| pts[v][d] + t * (pts[w][d] - pts[v][d]));
+        let pert = (pts.len() + k) as u32;
+        let a = plain.insert_steiner(x, pert).unwrap();
+        let iv = hinted.internal_ids(pts.len())[v];
+        hinted.start_walk_at(iv);
+        let b = hinted.insert_steiner(x, pert).unwrap();
+        assert_eq!(a.is_some(), b.is_some(), "point {k}");
+    }
+    // A vertex with no live tet (none here) or a ghost tet is ignored.
+    hinted.start_walk_at(u32::MAX - 1);
+    hinted.mesh.check_links().unwrap();
+    let ids = |dt: &Delaunay| {
+        let mut t: Vec<[u32; 4]> = sorted_tets(dt)
+            .into_iter()
+            .map(|x| x.map(|v| dt.orig[v as usize]))
+            .map(|mut x| {
+                x.sort_unstable();
+                x
+            })
+            .collect();
+        t.sort_unstable();
+        t
+    };
+    assert_eq!(ids(&plain), ids(&hinted));
+}
