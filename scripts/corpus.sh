@@ -14,8 +14,8 @@
 # holding files/ and tetgen_p_O0.tsv; a files/ directory itself is accepted too),
 # TETCDT (the binary, default target/release/tetcdt), TETCDT_TOOLS (the directory of
 # validate_mesh.py, default ../shared/tools), TIMEOUT (seconds per run, default 300),
-# REPEAT (runs of each timed command, TetGen's and ours alike, the fastest kept: the
-# machine's noise is about 10% from run to run; default 3).
+# REPEAT (runs of each timed command, TetGen's and ours alike, the fastest kept, the two
+# programs taking turns: the machine's noise is about 10% from run to run; default 3).
 #
 # Models: every file under $CORPUS/files that TetGen meshes with -pO0 according to
 # tetgen_p_O0.tsv (rc 0). For each, in a temporary work directory:
@@ -271,6 +271,39 @@ elapsed() { # start end -> seconds with 3 decimals
 }
 
 REPEAT="${REPEAT:-3}"
+# Runs two commands REPEAT times each, taking turns (the machine's speed drifts over
+# seconds: turns keep a slow spell from falling on one of them only); sets RUN_RC and
+# RUN_TIME for the first as `timed` does, and RUN_RC2 and RUN_TIME2 for the second.
+timed_pair() {
+    local k t0 t1 t b1="" b2="" stop1=0 stop2=0
+    for ((k = 0; k < REPEAT; k++)); do
+        if [[ $stop1 == 0 ]]; then
+            t0=$EPOCHREALTIME
+            "$1"
+            RUN_RC=$?
+            t1=$EPOCHREALTIME
+            t="$(elapsed "$t0" "$t1")"
+            if [[ -z "$b1" ]] || awk -v a="$t" -v b="$b1" 'BEGIN { exit !(a < b) }'; then
+                b1="$t"
+            fi
+            [[ $RUN_RC == 124 || $RUN_RC -gt 128 ]] && stop1=1
+        fi
+        if [[ $stop2 == 0 ]]; then
+            t0=$EPOCHREALTIME
+            "$2"
+            RUN_RC2=$?
+            t1=$EPOCHREALTIME
+            t="$(elapsed "$t0" "$t1")"
+            if [[ -z "$b2" ]] || awk -v a="$t" -v b="$b2" 'BEGIN { exit !(a < b) }'; then
+                b2="$t"
+            fi
+            [[ $RUN_RC2 == 124 || $RUN_RC2 -gt 128 ]] && stop2=1
+        fi
+    done
+    RUN_TIME="$b1"
+    RUN_TIME2="$b2"
+}
+
 # Runs a command REPEAT times (output redirections inside it apply to every run); sets
 # RUN_RC to the last run's exit code and RUN_TIME to the fastest run's seconds.
 timed() {
@@ -393,13 +426,19 @@ for rel in "${MODELS[@]}"; do
     tg_prefix="-"
     tg_time="${TSV_TIME[$rel]}"
     tg_note=""
+    run_ours() {
+        timeout "$TIMEOUT" "$TETCDT" -pQ -o "$dir/ours" "$input" >"$dir/ours.out" 2>"$dir/ours.err"
+    }
     if [[ $HAVE_TETGEN == 1 ]]; then
         run_tetgen() {
             (cd "$dir" && timeout "$TIMEOUT" tetgen -pO0Q "$name" >"$dir/tetgen.out" 2>&1)
         }
-        timed run_tetgen
+        # Timed in turns with ours (see `timed_pair`).
+        timed_pair run_tetgen run_ours
         tg_rc=$RUN_RC
         tg_time=$RUN_TIME
+        rc=$RUN_RC2
+        our_time=$RUN_TIME2
         if [[ $tg_rc == 0 && -f "$dir/$stem.1.node" && -f "$dir/$stem.1.ele" ]]; then
             tg_prefix="$dir/$stem.1"
             tg_tets_now="$(awk 'NF && $1 !~ /^#/ { print $1; exit }' "$dir/$stem.1.ele")"
@@ -409,13 +448,12 @@ for rel in "${MODELS[@]}"; do
         fi
     fi
 
-    # --- ours
-    run_ours() {
-        timeout "$TIMEOUT" "$TETCDT" -pQ -o "$dir/ours" "$input" >"$dir/ours.out" 2>"$dir/ours.err"
-    }
-    timed run_ours
-    rc=$RUN_RC
-    our_time=$RUN_TIME
+    # --- ours (already run in turns with TetGen when it is installed)
+    if [[ $HAVE_TETGEN != 1 ]]; then
+        timed run_ours
+        rc=$RUN_RC
+        our_time=$RUN_TIME
+    fi
     msg="$(oneline <"$dir/ours.err")"
     cmd="tetcdt -pQ $rel"
 
