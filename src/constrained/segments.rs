@@ -140,7 +140,7 @@ pub fn recover_segments(
                     dt.orig[a as usize], dt.orig[b as usize]
                 )));
             }
-            // The walk to the point starts at its piece's end: it lies on the piece.
+            // The point lies on the piece: the walk to it starts at the piece's end.
             dt.start_walk_at(pc.u);
             let Some(w) = dt.insert_steiner_noting(x, *next_pert, Some(&mut cavity.removed))?
             else {

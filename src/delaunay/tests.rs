@@ -420,7 +420,7 @@ fn walks_started_at_a_vertex_insert_the_same_points() {
         let b = hinted.insert_steiner(x, pert).unwrap();
         assert_eq!(a.is_some(), b.is_some(), "point {k}");
     }
-    // A vertex with no live tet (none here) or a ghost tet is ignored.
+    // A vertex the mesh does not have is ignored.
     hinted.start_walk_at(u32::MAX - 1);
     hinted.mesh.check_links().unwrap();
     let ids = |dt: &Delaunay| {
