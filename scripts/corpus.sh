@@ -271,56 +271,64 @@ elapsed() { # start end -> seconds with 3 decimals
 }
 
 REPEAT="${REPEAT:-3}"
-# Runs two commands REPEAT times each, taking turns (the machine's speed drifts over
-# seconds: turns keep a slow spell from falling on one of them only); sets RUN_RC and
-# RUN_TIME for the first as `timed` does, and RUN_RC2 and RUN_TIME2 for the second.
-timed_pair() {
-    local k t0 t1 t b1="" b2="" stop1=0 stop2=0
-    for ((k = 0; k < REPEAT; k++)); do
-        if [[ $stop1 == 0 ]]; then
-            t0=$EPOCHREALTIME
-            "$1"
-            RUN_RC=$?
-            t1=$EPOCHREALTIME
-            t="$(elapsed "$t0" "$t1")"
-            if [[ -z "$b1" ]] || awk -v a="$t" -v b="$b1" 'BEGIN { exit !(a < b) }'; then
-                b1="$t"
-            fi
-            [[ $RUN_RC == 124 || $RUN_RC -gt 128 ]] && stop1=1
-        fi
-        if [[ $stop2 == 0 ]]; then
-            t0=$EPOCHREALTIME
-            "$2"
-            RUN_RC2=$?
-            t1=$EPOCHREALTIME
-            t="$(elapsed "$t0" "$t1")"
-            if [[ -z "$b2" ]] || awk -v a="$t" -v b="$b2" 'BEGIN { exit !(a < b) }'; then
-                b2="$t"
-            fi
-            [[ $RUN_RC2 == 124 || $RUN_RC2 -gt 128 ]] && stop2=1
-        fi
-    done
-    RUN_TIME="$b1"
-    RUN_TIME2="$b2"
+# Runs a command once; sets ONCE_RC to its exit code and ONCE_TIME to its seconds.
+run_once() {
+    local t0 t1
+    t0=$EPOCHREALTIME
+    "$@"
+    ONCE_RC=$?
+    t1=$EPOCHREALTIME
+    ONCE_TIME="$(elapsed "$t0" "$t1")"
+}
+
+# The smaller of two times, either of which may be empty (none yet).
+fastest() {
+    if [[ -z "$2" ]] || awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'; then
+        echo "$1"
+    else
+        echo "$2"
+    fi
+}
+
+# A timeout or a crash is not repeated (a refusal is: it is the answer).
+ends_runs() {
+    [[ $1 == 124 || $1 -gt 128 ]]
 }
 
 # Runs a command REPEAT times (output redirections inside it apply to every run); sets
 # RUN_RC to the last run's exit code and RUN_TIME to the fastest run's seconds.
 timed() {
-    local k t0 t1 t best=""
+    local k best=""
     for ((k = 0; k < REPEAT; k++)); do
-        t0=$EPOCHREALTIME
-        "$@"
-        RUN_RC=$?
-        t1=$EPOCHREALTIME
-        t="$(elapsed "$t0" "$t1")"
-        if [[ -z "$best" ]] || awk -v a="$t" -v b="$best" 'BEGIN { exit !(a < b) }'; then
-            best="$t"
-        fi
-        # A timeout or a crash is not repeated (a refusal is: it is the answer).
-        [[ $RUN_RC == 124 || $RUN_RC -gt 128 ]] && break
+        run_once "$@"
+        RUN_RC=$ONCE_RC
+        best="$(fastest "$ONCE_TIME" "$best")"
+        ends_runs "$RUN_RC" && break
     done
     RUN_TIME="$best"
+}
+
+# Runs two commands REPEAT times each, taking turns (the machine's speed drifts over
+# seconds: turns keep a slow spell from falling on one of them only); sets RUN_RC and
+# RUN_TIME for the first as `timed` does, and RUN_RC2 and RUN_TIME2 for the second.
+timed_pair() {
+    local k b1="" b2="" stop1=0 stop2=0
+    for ((k = 0; k < REPEAT; k++)); do
+        if [[ $stop1 == 0 ]]; then
+            run_once "$1"
+            RUN_RC=$ONCE_RC
+            b1="$(fastest "$ONCE_TIME" "$b1")"
+            ends_runs "$RUN_RC" && stop1=1
+        fi
+        if [[ $stop2 == 0 ]]; then
+            run_once "$2"
+            RUN_RC2=$ONCE_RC
+            b2="$(fastest "$ONCE_TIME" "$b2")"
+            ends_runs "$RUN_RC2" && stop2=1
+        fi
+    done
+    RUN_TIME="$b1"
+    RUN_TIME2="$b2"
 }
 
 ROWS=()
