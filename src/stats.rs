@@ -75,6 +75,10 @@ impl Stats {
                 "    restarts for Steiner points on polygons",
                 p.restarts.to_string(),
             ),
+            (
+                "    points put in without a restart",
+                p.in_place_splits.to_string(),
+            ),
         ];
         if p.inserter == crate::constrained::FacetInserter::Flip {
             let f = &p.flips;
@@ -156,7 +160,7 @@ impl Stats {
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 19] = [
+            let pairs: [(&str, String); 21] = [
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),
@@ -173,6 +177,8 @@ impl Stats {
                 ),
                 ("enlarged_tets", p.enlarged_tets.to_string()),
                 ("restarts", p.restarts.to_string()),
+                ("in_place_splits", p.in_place_splits.to_string()),
+                ("in_place_off", p.in_place_off.to_string()),
                 ("segment_secs", json_f64(p.segment_secs)),
                 ("surface_secs", json_f64(p.surface_secs)),
                 ("facet_secs", json_f64(p.facet_secs)),

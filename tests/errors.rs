@@ -260,6 +260,22 @@ fn fuzz_regression_point_location_in_the_cdt_ends() {
     assert_eq!(code, Some(0), "{stderr}");
 }
 
+/// Found by `tests/fuzz.rs`: a prism with one vertex moved 1e20 units down. Updates of
+/// the CDT in place of restarts (subsegment splits) closed in on its Steiner points
+/// without settling them, and the construction then gave up where restarts alone
+/// succeed (and with unbounded updates, ran for over a minute). The updates are now
+/// bounded, and a construction that fails after them is done again without them.
+#[test]
+fn fuzz_regression_updates_in_place_fall_back_to_restarts() {
+    let (code, stderr) = mutated(
+        "plc/prism_n8_d1e-5_s1000.poly",
+        "\n0 1500 -500 -250.00675292370607\n",
+        "\n0 1500 -500 -99999999999999999999\n",
+        &["-pQ", "--check"],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+}
+
 #[test]
 fn duplicate_facet_exits_3() {
     refused(

@@ -697,6 +697,41 @@ fn a_steiner_point_on_a_polygon_goes_into_the_cdt_without_a_restart() {
     }
 }
 
+#[test]
+fn refused_steiner_points_split_subsegments_in_place_instead_of_restarting() {
+    // Steiner points on rotor_small's polygons encroach upon subsegments: the CDT
+    // refuses them, and the whole construction used to start again with them (twice).
+    // The subsegments are now split in place, the facets through them triangulated and
+    // recovered again, and a point refused for its own facet's subfaces goes in with
+    // them taken out. anchor.off has such a point too.
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat");
+    let dir = tempfile::tempdir().unwrap();
+    for (model, most_restarts) in [("rotor_small.off", 1), ("anchor.off", 1)] {
+        let m = data.join(model);
+        for (tag, flag) in [("c", "-pQ"), ("f", "-pQF")] {
+            let prefix = dir.path().join(format!("{model}-{tag}"));
+            let json = dir.path().join(format!("{model}-{tag}.json"));
+            let json_arg = json.to_str().unwrap();
+            let (code, err) = run(&m, &prefix, &[flag, "--check", "--stats-json", json_arg]);
+            assert_eq!(code, 0, "{model} {tag}: {err}");
+            let stats = std::fs::read_to_string(&json).unwrap();
+            assert!(
+                json_number(&stats, "in_place_splits") >= 1,
+                "{model} {tag}: {stats}"
+            );
+            assert!(
+                json_number(&stats, "restarts") <= most_restarts,
+                "{model} {tag}: {stats}"
+            );
+            if let Some(script) = validator() {
+                if let Err(report) = referee(&script, &m, &prefix, &[]) {
+                    panic!("{model} {tag}: {report}");
+                }
+            }
+        }
+    }
+}
+
 /// STL models on which our CDT and TetGen's differ only by the numbering of the welded
 /// points (`data/stl_numbering/README.md`): numbered as TetGen numbers them, our tets are
 /// TetGen's; numbered by first appearance, as we read STL, the mesh is valid and has the

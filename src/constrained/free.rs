@@ -50,7 +50,7 @@ pub(super) fn insert_free(
                     added += 1;
                     continue 'tets;
                 }
-                Inserted::Refused => {}
+                Inserted::Refused { .. } => {}
                 Inserted::OnVertex => continue 'tets,
             }
         }
@@ -67,8 +67,12 @@ pub(super) enum Inserted {
         changes: Vec<Change>,
         last: TetId,
     },
-    /// It would break the CDT: nothing changed.
-    Refused,
+    /// It would break the CDT: nothing changed. With the subsegment it would remove, or
+    /// the subface its cavity would wrap around, when that is why.
+    Refused {
+        lost: Option<(VertexId, VertexId)>,
+        wrapped: Option<[VertexId; 3]>,
+    },
     /// It coincides with a vertex: nothing changed.
     OnVertex,
 }
@@ -99,12 +103,25 @@ pub(super) fn insert_point(
             if super::debug() {
                 eprintln!("point {w:?}: its cavity wraps around a subface");
             }
-            return Ok(Inserted::Refused);
+            let subfaces = &cdt.subfaces;
+            let wrapped = cdt.dt.wrapped_face(|v: [VertexId; 4], f: usize| {
+                let fv = FACE_VERTS[f];
+                subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
+            });
+            return Ok(Inserted::Refused {
+                lost: None,
+                wrapped,
+            });
         }
     };
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
-    if settled && keeps_subsegments(cdt, &changes, at) {
+    let lost = if settled {
+        lost_subsegment(cdt, &changes, at)
+    } else {
+        None
+    };
+    if settled && lost.is_none() {
         return Ok(Inserted::Yes {
             vertex,
             changes,
@@ -122,7 +139,10 @@ pub(super) fn insert_point(
         );
     }
     cdt.dt.undo(vertex, &changes, last);
-    Ok(Inserted::Refused)
+    Ok(Inserted::Refused {
+        lost,
+        wrapped: None,
+    })
 }
 
 /// Takes back a point that [`insert_point`] put in, if nothing has changed since.
@@ -209,18 +229,23 @@ fn not_delaunay(cdt: &Cdt, f: FaceRef) -> bool {
     insphere_sos(p, orig) == Sign::Positive
 }
 
-/// Are the subsegments between vertices of the changed tets still mesh edges? Only
-/// those can have gone.
-fn keeps_subsegments(cdt: &mut Cdt, changes: &[Change], at: &VertexLists<VertexId>) -> bool {
+/// A subsegment between vertices of the changed tets that is no longer a mesh edge
+/// (only those can have gone), if any.
+fn lost_subsegment(
+    cdt: &mut Cdt,
+    changes: &[Change],
+    at: &VertexLists<VertexId>,
+) -> Option<(VertexId, VertexId)> {
     let mut verts: Vec<VertexId> = changes
         .iter()
         .flat_map(|c| c.old.iter().flat_map(|(_, tet)| tet.v))
         .collect();
     verts.sort_unstable();
     verts.dedup();
-    verts.iter().all(|&x| {
+    verts.iter().find_map(|&x| {
         at.of(x)
             .iter()
-            .all(|&y| x > y || verts.binary_search(&y).is_err() || cdt.has_edge(x, y))
+            .find(|&&y| x < y && verts.binary_search(&y).is_ok() && !cdt.has_edge(x, y))
+            .map(|&y| (x, y))
     })
 }

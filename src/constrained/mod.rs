@@ -151,6 +151,12 @@ pub struct PlcStats {
     pub enlarged_tets: usize,
     /// Restarts caused by Steiner points on polygons.
     pub restarts: usize,
+    /// Subsegments split in place, for Steiner points on polygons that encroached upon
+    /// them, instead of a restart.
+    pub in_place_splits: usize,
+    /// Whether those updates were turned off: with them the construction did not
+    /// converge, so it was done again without.
+    pub in_place_off: bool,
     /// Edge-triangle crossing tests over all attempts (bounds the restarts' work).
     pub crossing_tests: u64,
     /// Seconds for the Delaunay tetrahedralization.
@@ -366,6 +372,16 @@ pub fn mesh_plc_with_progress(
                 retry_failed = true;
                 continue;
             }
+            // Updates in place may lead a construction astray where restarts would
+            // not: it is done again without them.
+            Err(_) if stats.in_place_splits > 0 && !stats.in_place_off => {
+                (facet_points, presplits, first_work) = (Vec::new(), Vec::new(), 0);
+                stats = PlcStats {
+                    in_place_off: true,
+                    ..stats0.clone()
+                };
+                continue;
+            }
             Err(e) => return Err(e),
         };
         match outcome {
@@ -415,6 +431,14 @@ pub fn mesh_plc_with_progress(
                     || stats.crossing_tests > RESTART_WORK + 8 * first_work;
                 if (over_steiner || over_work) && retry.is_some() {
                     retry_failed = true;
+                    continue;
+                }
+                if (over_steiner || over_work) && stats.in_place_splits > 0 && !stats.in_place_off {
+                    (facet_points, presplits, first_work) = (Vec::new(), Vec::new(), 0);
+                    stats = PlcStats {
+                        in_place_off: true,
+                        ..stats0.clone()
+                    };
                     continue;
                 }
                 if over_steiner {
@@ -551,7 +575,7 @@ fn attempt(
     let t1 = Instant::now();
     let mut next_pert = points.len() as u32;
     let budget = opts.max_steiner.saturating_sub(facet_points.len());
-    let subsegs = segments::recover_segments(
+    let mut subsegs = segments::recover_segments(
         &mut dt,
         &prep.segments,
         points.len(),
@@ -603,8 +627,8 @@ fn attempt(
     // tets: all are computed up front, on two cores, and only they are indexed for the
     // lookups of the mesh faces.
     let t_surface = Instant::now();
-    let ctx = FacetContext::new(plc, prep, &dt, &inv, &seg_index, &subsegs, &extra);
-    let mut facet_tris = ctx.triangulate_all();
+    let mut facet_tris =
+        FacetContext::new(plc, prep, &dt, &inv, &seg_index, &subsegs, &extra).triangulate_all();
     stats.surface_secs = t_surface.elapsed().as_secs_f64();
     let wanted: Vec<[VertexId; 3]> = facet_tris
         .iter()
@@ -625,7 +649,18 @@ fn attempt(
     let max_rounds = 20 * prep.facets.len() + 1000;
     // Steiner points put on facets in this attempt, and the subsegments' ends they check.
     let mut placed_on_facets = 0usize;
+    // Updates of the CDT in place of a restart (see `split_encroached`), bounded in all
+    // and for each Steiner point (one that keeps asking for them is better made an
+    // input vertex).
+    let mut in_place = 0usize;
+    let mut in_place_for: FxHashMap<[u64; 3], usize> = FxHashMap::default();
+    // The splits and points they made, for the next construction if there is one.
+    let mut carried: (Vec<SegmentSplit>, Vec<FacetPoint>) = (Vec::new(), Vec::new());
     let mut ends = None;
+    // Facets to triangulate again once the current one is done (after a subsegment was
+    // split in place), and the facets of each segment, made when first needed.
+    let mut retriangulate: Vec<usize> = Vec::new();
+    let mut facets_of_seg: Option<Vec<Vec<usize>>> = None;
     stats.facet_steiner_points = 0;
     while let Some(fi) = queue.pop() {
         opts.check_cancel()?;
@@ -689,9 +724,19 @@ fn attempt(
                     // place; otherwise the construction starts again with it.
                     let room = stats.steiner_points < opts.max_steiner
                         && placed_on_facets < max_facet_points(plc);
+                    let asked = in_place_for.entry(p.map(f64::to_bits)).or_insert(0);
+                    let update = !stats.in_place_off
+                        && in_place < MAX_IN_PLACE
+                        && *asked < MAX_IN_PLACE_EACH;
+                    *asked += 1;
                     if room {
                         let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
                         let inserted = free::insert_point(&mut cdt, p, next_pert, at)?;
+                        // Refused, and for which subsegment if one would be lost.
+                        let refused = match &inserted {
+                            free::Inserted::Refused { lost, .. } => Some(*lost),
+                            _ => None,
+                        };
                         if let free::Inserted::Yes { vertex, .. } = inserted {
                             extra[fi].push(vertex);
                             let ctx = FacetContext::new(
@@ -723,6 +768,71 @@ fn attempt(
                         } else if debug() {
                             eprintln!("facet {fi}: the CDT refuses the point");
                         }
+                        // A point refused for encroaching upon a subsegment: the
+                        // subsegment is split in place instead, and the facets through it
+                        // are triangulated and recovered again (the paper's update of a
+                        // CDT), which spares a whole construction. Failing that, the
+                        // point lies on the facet, whose own subfaces need not wall it
+                        // in: without them (and those it wraps around) it may go in, and
+                        // the facets are triangulated with it and recovered again.
+                        let mut segs = Segs {
+                            subsegs: &mut subsegs,
+                            seg_of: &mut seg_of,
+                            markers: &mut seg_markers,
+                            facets_of: &mut facets_of_seg,
+                        };
+                        let (mut split, mut unrecovered) = (None, None);
+                        if let (Some(lost), true) = (refused, update) {
+                            split = split_encroached(
+                                &mut cdt, p, lost, &mut segs, prep, &seg_index, next_pert, 0,
+                            )?;
+                            if split.is_none() {
+                                match insert_unrecovered(&mut cdt, p, fi, next_pert)? {
+                                    Ok(done) => unrecovered = Some(done),
+                                    // Then the subsegment it would remove is split.
+                                    Err(Some(lost)) => {
+                                        split = split_encroached(
+                                            &mut cdt,
+                                            p,
+                                            Some(lost),
+                                            &mut segs,
+                                            prep,
+                                            &seg_index,
+                                            next_pert,
+                                            0,
+                                        )?;
+                                    }
+                                    Err(None) => {}
+                                }
+                            }
+                        }
+                        let facets = match (split, unrecovered) {
+                            (Some((facets, at_split)), _) => {
+                                carried.0.push(at_split);
+                                Some(facets)
+                            }
+                            (None, Some((v, facets))) => {
+                                if debug() {
+                                    eprintln!("facet {fi}: in with facets {facets:?} unrecovered");
+                                }
+                                carried.1.push((fi, p));
+                                extra[fi].push(v);
+                                placed_on_facets += 1;
+                                stats.facet_steiner_points += 1;
+                                Some(facets)
+                            }
+                            (None, None) => None,
+                        };
+                        if let Some(facets) = facets {
+                            ends = None;
+                            next_pert += 1;
+                            stats.steiner_points += 1;
+                            stats.in_place_splits += 1;
+                            in_place += 1;
+                            retriangulate.extend(facets);
+                            retriangulate.push(fi);
+                            break;
+                        }
                     }
                     steiner.push((fi, p));
                     steiner_facets.insert(fi);
@@ -741,6 +851,16 @@ fn attempt(
         }
         if let Some(again) = retriangulated {
             facet_tris[fi] = again;
+        }
+        if !retriangulate.is_empty() {
+            let ctx = FacetContext::new(plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra);
+            for g in retriangulate.drain(..) {
+                facet_tris[g] = ctx.triangles(g);
+                if !queued[g] {
+                    queued[g] = true;
+                    queue.push(g);
+                }
+            }
         }
     }
     stats.facet_secs = t2.elapsed().as_secs_f64() - stats.surface_secs;
@@ -833,6 +953,11 @@ fn attempt(
         }
     }
     if !steiner.is_empty() || !splits.is_empty() {
+        // What the updates in place put in goes into the next construction too, which
+        // would otherwise have to find it again.
+        let (more_splits, more_points) = carried;
+        splits.extend(more_splits);
+        steiner.extend(more_points);
         return Ok(Attempt::Restart(steiner, splits));
     }
     let (flat_left, retry_points) = match flat_left {
@@ -1204,6 +1329,193 @@ impl<'a> FacetContext<'a> {
         }
         Ok(Some(tris))
     }
+}
+
+/// Inserts point `p` (perturbation index `pert`), on facet `fi`, into the CDT with the
+/// facet's subfaces taken out, so that they do not wall its cavity in, and those of up to
+/// [`MAX_UNRECOVERED`] more facets whose subfaces the cavity would wrap around. Its
+/// vertex and the facets taken out, to be triangulated and recovered again; or, with
+/// the subfaces put back, the subsegment it would remove, if that is why the CDT refuses
+/// it all the same.
+fn insert_unrecovered(
+    cdt: &mut Cdt,
+    p: Point,
+    fi: usize,
+    pert: u32,
+) -> Result<Unrecovered, MeshError> {
+    let mut facets = vec![fi];
+    let mut removed: Vec<([VertexId; 3], u32)> = Vec::new();
+    let outcome = loop {
+        let last = *facets.last().unwrap_or(&fi) as u32;
+        let out: Vec<[VertexId; 3]> = cdt
+            .subfaces
+            .iter()
+            .filter(|(_, &f)| f == last)
+            .map(|(&k, _)| k)
+            .collect();
+        for k in out {
+            cdt.subfaces.remove(&k);
+            removed.push((k, last));
+        }
+        let at = free::subsegment_ends(cdt);
+        match free::insert_point(cdt, p, pert, &at)? {
+            free::Inserted::Yes { vertex, .. } => break Ok(vertex),
+            free::Inserted::Refused {
+                wrapped: Some(face),
+                ..
+            } => match cdt.subfaces.get(&face_key(face)) {
+                Some(&g) if facets.len() <= MAX_UNRECOVERED => facets.push(g as usize),
+                _ => break Err(None),
+            },
+            free::Inserted::Refused { lost, .. } => break Err(lost),
+            free::Inserted::OnVertex => break Err(None),
+        }
+    };
+    if outcome.is_err() {
+        for (k, f) in removed {
+            cdt.subfaces.insert(k, f);
+        }
+    }
+    Ok(outcome.map(|v| (v, facets)))
+}
+
+/// What [`insert_unrecovered`] did: the point's vertex and the facets taken out, or
+/// (refused) the subsegment the point would remove, if that is why.
+type Unrecovered = Result<(VertexId, Vec<usize>), Option<(VertexId, VertexId)>>;
+
+/// The most facets besides its own that [`insert_unrecovered`] takes out for a point.
+const MAX_UNRECOVERED: usize = 4;
+
+/// The most updates of the CDT in place of a restart in one construction: each makes
+/// facets recovered again, and where they keep needing more (polygons far from flat)
+/// a restart, with the points as input vertices, settles it sooner.
+const MAX_IN_PLACE: usize = 64;
+
+/// The most updates in place for one Steiner point: past them, its splits have been
+/// closing in on it without settling it.
+const MAX_IN_PLACE_EACH: usize = 8;
+
+/// How many subsegments [`split_encroached`] passes the split on to, one after another.
+const MAX_SPLIT_DEPTH: usize = 4;
+
+/// The segments' state that splitting a subsegment in place updates.
+struct Segs<'a> {
+    subsegs: &'a mut segments::Subsegments,
+    seg_of: &'a mut FxHashMap<(VertexId, VertexId), usize>,
+    markers: &'a mut FxHashMap<(VertexId, VertexId), i32>,
+    /// The facets through each segment, made when first needed.
+    facets_of: &'a mut Option<Vec<Vec<usize>>>,
+}
+
+/// Splits, in place, the subsegment that point `p` (a refused Steiner point on a
+/// polygon) would remove (`lost`, when known) or else encroaches upon most closely, at
+/// its middle (perturbation index `pert`).
+/// The facets through it lose their subfaces, which the caller triangulates and
+/// recovers again; they are returned. `None`, with nothing changed, if `p` encroaches
+/// upon no subsegment or the CDT refuses the split point too.
+#[allow(clippy::too_many_arguments)] // the recursion passes them all on
+fn split_encroached(
+    cdt: &mut Cdt,
+    p: Point,
+    lost: Option<(VertexId, VertexId)>,
+    segs: &mut Segs<'_>,
+    prep: &PreparedPlc,
+    seg_index: &FxHashMap<(u32, u32), usize>,
+    pert: u32,
+    depth: usize,
+) -> Result<Option<(Vec<usize>, SegmentSplit)>, MeshError> {
+    let pt = |x: VertexId| cdt.dt.points[x as usize];
+    // Inside the diametral sphere: the angle at `p` is obtuse. The closest such
+    // subsegment (by distance to its middle) is the one to split.
+    let mut best: Option<((VertexId, VertexId), f64)> = lost
+        .filter(|e| segs.markers.contains_key(e))
+        .map(|e| (e, 0.0));
+    for (&(u, v), _) in segs.markers.iter().filter(|_| lost.is_none()) {
+        let (a, b) = (pt(u), pt(v));
+        let along: f64 = (0..3).map(|k| (a[k] - p[k]) * (b[k] - p[k])).sum();
+        if along >= 0.0 {
+            continue;
+        }
+        let d: f64 = (0..3).map(|k| (0.5 * (a[k] + b[k]) - p[k]).powi(2)).sum();
+        if best.is_none_or(|(e, bd)| d < bd || (d == bd && (u, v) < e)) {
+            best = Some(((u, v), d));
+        }
+    }
+    let Some(((u, v), _)) = best else {
+        return Ok(None);
+    };
+    let seg = segs.seg_of[&(u, v)];
+    let chain = &segs.subsegs.chains[seg];
+    let s = midpoint_parameter(cdt, chain, u, v);
+    let (pa, pb) = (pt(chain[0]), pt(*chain.last().unwrap_or(&chain[0])));
+    let m: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
+    if m == pt(u) || m == pt(v) {
+        return Ok(None);
+    }
+    let facets = segs.facets_of.get_or_insert_with(|| {
+        let mut of = vec![Vec::new(); prep.segments.len()];
+        for (fi, f) in prep.facets.iter().enumerate() {
+            for_each_edge(f, |a, b| {
+                if let Some(&si) = seg_index.get(&(a.min(b), a.max(b))) {
+                    if of[si].last() != Some(&fi) {
+                        of[si].push(fi);
+                    }
+                }
+            });
+        }
+        of
+    });
+    let through: Vec<usize> = facets[seg].clone();
+    // The facets through the subsegment are unrecovered: their subfaces would wall the
+    // split point's cavity in on both sides. Kept to be put back if it is refused.
+    let removed: Vec<([VertexId; 3], u32)> = cdt
+        .subfaces
+        .iter()
+        .filter(|(_, &f)| through.contains(&(f as usize)))
+        .map(|(&k, &f)| (k, f))
+        .collect();
+    for (k, _) in &removed {
+        cdt.subfaces.remove(k);
+    }
+    let marker = segs.markers.remove(&(u, v)).unwrap_or(0);
+    cdt.subsegs.remove(&(u, v));
+    let at = free::subsegment_ends(cdt);
+    let inserted = free::insert_point(cdt, m, pert, &at)?;
+    let free::Inserted::Yes { vertex: w, .. } = inserted else {
+        for (k, f) in removed {
+            cdt.subfaces.insert(k, f);
+        }
+        segs.markers.insert((u, v), marker);
+        cdt.subsegs.insert((u, v), marker);
+        // A split point that would remove another subsegment splits that one instead,
+        // a few levels deep (a chain of encroachments, as in Ruppert's refinement).
+        return match inserted {
+            free::Inserted::Refused { lost: Some(e), .. }
+                if e != (u, v) && depth < MAX_SPLIT_DEPTH =>
+            {
+                split_encroached(cdt, m, Some(e), segs, prep, seg_index, pert, depth + 1)
+            }
+            _ => Ok(None),
+        };
+    };
+    if debug() {
+        eprintln!("split subsegment {u}-{v} in place at {m:?}: facets {through:?} again");
+    }
+    let chain = &mut segs.subsegs.chains[seg];
+    if let Some(i) = chain
+        .windows(2)
+        .position(|x| edge_key(x[0], x[1]) == (u, v))
+    {
+        chain.insert(i + 1, w);
+    }
+    segs.subsegs.steiner_points += 1;
+    segs.seg_of.remove(&(u, v));
+    for e in [edge_key(u, w), edge_key(w, v)] {
+        segs.seg_of.insert(e, seg);
+        segs.markers.insert(e, marker);
+        cdt.subsegs.insert(e, marker);
+    }
+    Ok(Some((through, (seg, s))))
 }
 
 /// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.

@@ -144,6 +144,21 @@ impl Delaunay {
         })
     }
 
+    /// After [`Delaunay::insert_walled`] refused a point, a blocked face that its cavity
+    /// reached from both sides, if that is why.
+    pub fn wrapped_face(
+        &self,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Option<[VertexId; 3]> {
+        let inside: rustc_hash::FxHashSet<TetId> = self.conflict.iter().copied().collect();
+        self.conflict.iter().find_map(|&t| {
+            let tet = self.mesh.tet(t);
+            (0..4)
+                .find(|&f| blocked(tet.v, f) && inside.contains(&tet.adj[f].tet()))
+                .map(|f| self.mesh.face_verts(t, f))
+        })
+    }
+
     /// Takes back the insertion of the last vertex `v` and the changes made since (in
     /// `changes`, oldest first, the insertion's own first), restoring the mesh exactly;
     /// `last` is where point location started before.
