@@ -37,7 +37,7 @@ pub(super) fn insert_free(
     let mut refused = Vec::new();
     'tets: for ws in free {
         for c in ws {
-            let inserted = insert_point(cdt, c.at, *next_pert, &at)?;
+            let inserted = insert_point(cdt, c.at, *next_pert, &at, false)?;
             match &inserted {
                 &Inserted::Yes { vertex, .. } if c.checked && !accept(cdt, vertex) => {
                     if super::debug() {
@@ -80,12 +80,14 @@ pub(super) enum Inserted {
 /// Inserts point `w` (perturbation index `pert`) into the CDT: a cavity walled in by the
 /// subfaces, then flips until every face is locally Delaunay again. Refused, leaving
 /// the CDT as it was, if the flips cannot get there or a subsegment (`at`, from
-/// [`subsegment_ends`]) would be lost.
+/// [`subsegment_ends`]) would be lost. `wrapped_asked`: whether a refusal should name the
+/// subface the cavity wraps around (a search over the cavity, wasted where nobody asks).
 pub(super) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
     pert: u32,
     at: &VertexLists<VertexId>,
+    wrapped_asked: bool,
 ) -> Result<Inserted, MeshError> {
     let subfaces = &cdt.subfaces;
     let blocked = |v: [VertexId; 4], f: usize| {
@@ -104,10 +106,14 @@ pub(super) fn insert_point(
                 eprintln!("point {w:?}: its cavity wraps around a subface");
             }
             let subfaces = &cdt.subfaces;
-            let wrapped = cdt.dt.wrapped_face(|v: [VertexId; 4], f: usize| {
-                let fv = FACE_VERTS[f];
-                subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
-            });
+            let wrapped = wrapped_asked
+                .then(|| {
+                    cdt.dt.wrapped_face(|v: [VertexId; 4], f: usize| {
+                        let fv = FACE_VERTS[f];
+                        subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
+                    })
+                })
+                .flatten();
             return Ok(Inserted::Refused {
                 lost: None,
                 wrapped,

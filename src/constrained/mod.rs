@@ -731,7 +731,7 @@ fn attempt(
                     *asked += 1;
                     if room {
                         let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
-                        let inserted = free::insert_point(&mut cdt, p, next_pert, at)?;
+                        let inserted = free::insert_point(&mut cdt, p, next_pert, at, false)?;
                         // Refused, and for which subsegment if one would be lost.
                         let refused = match &inserted {
                             free::Inserted::Refused { lost, .. } => Some(*lost),
@@ -1358,7 +1358,7 @@ fn insert_unrecovered(
             removed.push((k, last));
         }
         let at = free::subsegment_ends(cdt);
-        match free::insert_point(cdt, p, pert, &at)? {
+        match free::insert_point(cdt, p, pert, &at, true)? {
             free::Inserted::Yes { vertex, .. } => break Ok(vertex),
             free::Inserted::Refused {
                 wrapped: Some(face),
@@ -1480,7 +1480,7 @@ fn split_encroached(
     let marker = segs.markers.remove(&(u, v)).unwrap_or(0);
     cdt.subsegs.remove(&(u, v));
     let at = free::subsegment_ends(cdt);
-    let inserted = free::insert_point(cdt, m, pert, &at)?;
+    let inserted = free::insert_point(cdt, m, pert, &at, false)?;
     let free::Inserted::Yes { vertex: w, .. } = inserted else {
         for (k, f) in removed {
             cdt.subfaces.insert(k, f);
