@@ -151,8 +151,8 @@ pub struct PlcStats {
     pub enlarged_tets: usize,
     /// Restarts caused by Steiner points on polygons.
     pub restarts: usize,
-    /// Subsegments split in place, for Steiner points on polygons that encroached upon
-    /// them, instead of a restart.
+    /// Updates of the CDT in place of a restart, for Steiner points on polygons that it
+    /// refused: subsegments split in place, and points put in with facets taken out.
     pub in_place_splits: usize,
     /// Whether those updates were turned off: with them the construction did not
     /// converge, so it was done again without.
@@ -225,6 +225,16 @@ const MAX_FREE_ROUNDS: usize = 12;
 /// the construction again: each costs a whole construction, and past a few they do not
 /// converge (on fans of needle triangles every restart finds new flat tets).
 const MAX_FREE_RESTARTS: usize = 3;
+
+/// The state to start the constructions over from, with updates in place turned off
+/// (`stats0` as at the start): no points from earlier attempts, no work done.
+fn without_updates(stats0: &PlcStats) -> (Vec<FacetPoint>, Vec<SegmentSplit>, u64, PlcStats) {
+    let stats = PlcStats {
+        in_place_off: true,
+        ..stats0.clone()
+    };
+    (Vec::new(), Vec::new(), 0, stats)
+}
 
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
@@ -375,11 +385,7 @@ pub fn mesh_plc_with_progress(
             // Updates in place may lead a construction astray where restarts would
             // not: it is done again without them.
             Err(_) if stats.in_place_splits > 0 && !stats.in_place_off => {
-                (facet_points, presplits, first_work) = (Vec::new(), Vec::new(), 0);
-                stats = PlcStats {
-                    in_place_off: true,
-                    ..stats0.clone()
-                };
+                (facet_points, presplits, first_work, stats) = without_updates(&stats0);
                 continue;
             }
             Err(e) => return Err(e),
@@ -434,11 +440,7 @@ pub fn mesh_plc_with_progress(
                     continue;
                 }
                 if (over_steiner || over_work) && stats.in_place_splits > 0 && !stats.in_place_off {
-                    (facet_points, presplits, first_work) = (Vec::new(), Vec::new(), 0);
-                    stats = PlcStats {
-                        in_place_off: true,
-                        ..stats0.clone()
-                    };
+                    (facet_points, presplits, first_work, stats) = without_updates(&stats0);
                     continue;
                 }
                 if over_steiner {
@@ -598,13 +600,9 @@ fn attempt(
         .collect();
     // Each subsegment takes the marker of the first facet that contains its segment.
     let mut seg_marker = vec![None; prep.segments.len()];
-    for f in &prep.facets {
-        for_each_edge(f, |a, b| {
-            if let Some(&i) = seg_index.get(&(a.min(b), a.max(b))) {
-                seg_marker[i].get_or_insert(f.marker);
-            }
-        });
-    }
+    for_each_facet_segment(prep, &seg_index, |fi, si| {
+        seg_marker[si].get_or_insert(prep.facets[fi].marker);
+    });
     // Sized up front: growing maps of this many entries rehashes them over and over.
     let pieces: usize = subsegs.chains.iter().map(|c| c.len() - 1).sum();
     let mut seg_markers = FxHashMap::with_capacity_and_hasher(pieces, rustc_hash::FxBuildHasher);
@@ -787,7 +785,7 @@ fn attempt(
                                 &mut cdt, p, lost, &mut segs, prep, &seg_index, next_pert, 0,
                             )?;
                             if split.is_none() {
-                                match insert_unrecovered(&mut cdt, p, fi, next_pert)? {
+                                match insert_unrecovered(&mut cdt, p, fi, next_pert, at)? {
                                     Ok(done) => unrecovered = Some(done),
                                     // Then the subsegment it would remove is split.
                                     Err(Some(lost)) => {
@@ -1336,29 +1334,20 @@ impl<'a> FacetContext<'a> {
 /// [`MAX_UNRECOVERED`] more facets whose subfaces the cavity would wrap around. Its
 /// vertex and the facets taken out, to be triangulated and recovered again; or, with
 /// the subfaces put back, the subsegment it would remove, if that is why the CDT refuses
-/// it all the same.
+/// it all the same. `at` as for [`free::insert_point`] (taking subfaces out leaves it).
 fn insert_unrecovered(
     cdt: &mut Cdt,
     p: Point,
     fi: usize,
     pert: u32,
+    at: &crate::mesh::VertexLists<VertexId>,
 ) -> Result<Unrecovered, MeshError> {
     let mut facets = vec![fi];
     let mut removed: Vec<([VertexId; 3], u32)> = Vec::new();
     let outcome = loop {
         let last = *facets.last().unwrap_or(&fi) as u32;
-        let out: Vec<[VertexId; 3]> = cdt
-            .subfaces
-            .iter()
-            .filter(|(_, &f)| f == last)
-            .map(|(&k, _)| k)
-            .collect();
-        for k in out {
-            cdt.subfaces.remove(&k);
-            removed.push((k, last));
-        }
-        let at = free::subsegment_ends(cdt);
-        match free::insert_point(cdt, p, pert, &at, true)? {
+        removed.extend(take_out_subfaces(cdt, |f| f == last));
+        match free::insert_point(cdt, p, pert, at, true)? {
             free::Inserted::Yes { vertex, .. } => break Ok(vertex),
             free::Inserted::Refused {
                 wrapped: Some(face),
@@ -1372,11 +1361,39 @@ fn insert_unrecovered(
         }
     };
     if outcome.is_err() {
-        for (k, f) in removed {
-            cdt.subfaces.insert(k, f);
-        }
+        cdt.subfaces.extend(removed);
     }
     Ok(outcome.map(|v| (v, facets)))
+}
+
+/// Takes the subfaces of the facets that `of` picks out of the CDT (unrecovering those
+/// facets), and returns them, to be put back with their facets.
+fn take_out_subfaces(cdt: &mut Cdt, of: impl Fn(u32) -> bool) -> Vec<([VertexId; 3], u32)> {
+    let out: Vec<([VertexId; 3], u32)> = cdt
+        .subfaces
+        .iter()
+        .filter(|(_, &f)| of(f))
+        .map(|(&k, &f)| (k, f))
+        .collect();
+    for (k, _) in &out {
+        cdt.subfaces.remove(k);
+    }
+    out
+}
+
+/// Calls `f(facet, segment)` for each input segment on each facet's boundary or inside it.
+fn for_each_facet_segment(
+    prep: &PreparedPlc,
+    seg_index: &FxHashMap<(u32, u32), usize>,
+    mut f: impl FnMut(usize, usize),
+) {
+    for (fi, facet) in prep.facets.iter().enumerate() {
+        for_each_edge(facet, |a, b| {
+            if let Some(&si) = seg_index.get(&(a.min(b), a.max(b))) {
+                f(fi, si);
+            }
+        });
+    }
 }
 
 /// What [`insert_unrecovered`] did: the point's vertex and the facets taken out, or
@@ -1454,37 +1471,23 @@ fn split_encroached(
     }
     let facets = segs.facets_of.get_or_insert_with(|| {
         let mut of = vec![Vec::new(); prep.segments.len()];
-        for (fi, f) in prep.facets.iter().enumerate() {
-            for_each_edge(f, |a, b| {
-                if let Some(&si) = seg_index.get(&(a.min(b), a.max(b))) {
-                    if of[si].last() != Some(&fi) {
-                        of[si].push(fi);
-                    }
-                }
-            });
-        }
+        for_each_facet_segment(prep, seg_index, |fi, si| {
+            if of[si].last() != Some(&fi) {
+                of[si].push(fi);
+            }
+        });
         of
     });
     let through: Vec<usize> = facets[seg].clone();
     // The facets through the subsegment are unrecovered: their subfaces would wall the
     // split point's cavity in on both sides. Kept to be put back if it is refused.
-    let removed: Vec<([VertexId; 3], u32)> = cdt
-        .subfaces
-        .iter()
-        .filter(|(_, &f)| through.contains(&(f as usize)))
-        .map(|(&k, &f)| (k, f))
-        .collect();
-    for (k, _) in &removed {
-        cdt.subfaces.remove(k);
-    }
+    let removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
     let marker = segs.markers.remove(&(u, v)).unwrap_or(0);
     cdt.subsegs.remove(&(u, v));
     let at = free::subsegment_ends(cdt);
     let inserted = free::insert_point(cdt, m, pert, &at, false)?;
     let free::Inserted::Yes { vertex: w, .. } = inserted else {
-        for (k, f) in removed {
-            cdt.subfaces.insert(k, f);
-        }
+        cdt.subfaces.extend(removed);
         segs.markers.insert((u, v), marker);
         cdt.subsegs.insert((u, v), marker);
         // A split point that would remove another subsegment splits that one instead,

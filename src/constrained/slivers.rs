@@ -625,14 +625,7 @@ fn longest_edge2(p: &[Point; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A small deterministic generator (no dependency for one test).
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::geom::lcg;
 
     #[test]
     fn tets_in_a_slab_pass_the_thinness_bound_and_thick_ones_do_not() {
