@@ -179,6 +179,8 @@ fn mutated(model: &str, from: &str, to: &str, args: &[&str]) -> (Option<i32>, St
         .current_dir(dir.path())
         .args(args)
         .arg(name)
+        // A hang guard, far above any of these runs (killed: no exit code).
+        .timeout(std::time::Duration::from_secs(30))
         .output()
         .unwrap();
     (
@@ -274,6 +276,28 @@ fn fuzz_regression_updates_in_place_fall_back_to_restarts() {
         &["-pQ", "--check"],
     );
     assert_eq!(code, Some(0), "{stderr}");
+}
+
+/// Found by `tests/fuzz.rs` in CI: one corner of a 40-gon prism moved 1.8e19 away (the
+/// other coordinates are within 0.5) makes every flip-time comparison of `-F` need exact
+/// arithmetic on long expansions; the restarts that do not settle the polygons then ran
+/// for over a minute, since only crossing tests counted as their work. Exact comparisons
+/// now count too (and products are compressed), and the run ends within seconds.
+#[test]
+fn fuzz_regression_far_corner_ends_flip_insertion_in_bounded_work() {
+    for algo in ["-pQF", "-pQ"] {
+        let (code, stderr) = mutated(
+            "plc/prism_n40_d1e-5_s1.poly",
+            "\n6 0.29389262614623657 0.4045084971874737 -0.5000067566867479\n",
+            "\n6 0.29389262614623657 0.4045084971874737 -18446744073709551616\n",
+            &[algo],
+        );
+        assert_eq!(code, Some(1), "{algo}: {stderr}");
+        assert!(
+            stderr.contains("polygons that are not flat still conflict after"),
+            "{algo}: {stderr}"
+        );
+    }
 }
 
 #[test]

@@ -551,8 +551,8 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     if v[3] == GHOST {
         return false;
     }
-    let tests = &cdt.crossing_tests;
-    tests.set(tests.get() + region.tris.len() as u64);
+    let work = &cdt.work;
+    work.set(work.get() + region.tris.len() as u64);
     region.crossed_by_tet(&cdt.dt.points, v)
 }
 

@@ -36,8 +36,9 @@ pub struct Cdt {
     /// hint that [`Cdt::has_face`] confirms in constant time while that tet is unchanged.
     face_index: FxHashMap<[VertexId; 3], FaceRef>,
     scratch: Vec<TetId>,
-    /// Edge-triangle crossing tests made so far: the work that bounds restarts.
-    pub crossing_tests: std::cell::Cell<u64>,
+    /// The work done so far, which bounds restarts: edge-triangle crossing tests, and
+    /// exact flip-time comparisons in units of about the same cost.
+    pub work: std::cell::Cell<u64>,
 }
 
 impl Cdt {
@@ -49,7 +50,7 @@ impl Cdt {
             subfaces: FxHashMap::default(),
             face_index: FxHashMap::default(),
             scratch: Vec::new(),
-            crossing_tests: std::cell::Cell::new(0),
+            work: std::cell::Cell::new(0),
         }
     }
 

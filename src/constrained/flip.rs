@@ -240,6 +240,10 @@ fn put<T>(slots: &mut Vec<T>, free: &mut Vec<u32>, x: T) -> u32 {
     }
 }
 
+/// Work units ([`Cdt::work`]) per unit of [`CompareCounts::exact_work`]: a product of
+/// components costs about 64 ns, a crossing test about 35 ns (both measured with perf).
+const EXACT_WORK_UNITS: u64 = 2;
+
 /// Inserts the region `tris` of facet `facet` by flips; same contract as
 /// [`cavity::insert_region`]. Adds this region's figures to `total`, whatever the outcome.
 pub fn insert_region(
@@ -274,15 +278,23 @@ pub fn insert_region(
     let mut here = fl.counts;
     here.exact_compares = fl.cmp.exact;
     here.perturbed_compares = fl.cmp.perturbed;
+    // A comparison of flip times that needs exact arithmetic is cheap on near-ties of
+    // nearby points, but a vertex 1e19 away makes every one of them long expansions:
+    // counted as work, such runs end under the bound on restarts instead of hanging.
+    let exact_work = fl.cmp.exact_work;
+    fl.cdt
+        .work
+        .set(fl.cdt.work.get() + EXACT_WORK_UNITS * exact_work);
     counts.add(&here);
     let mut at_risk = std::mem::take(&mut fl.at_risk);
     let crossing_left = fl.crossing_left;
     drop(fl);
     if debug() {
         eprintln!(
-            "facet {facet}: {} crossing tets, {} flips, problem {problem:?}",
+            "facet {facet}: {} crossing tets, {} flips, problem {problem:?}, {} exact compares",
             crossing.len(),
-            counts.total()
+            counts.total(),
+            here.exact_compares
         );
     }
     match problem {

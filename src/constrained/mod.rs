@@ -157,8 +157,8 @@ pub struct PlcStats {
     /// Whether those updates were turned off: with them the construction did not
     /// converge, so it was done again without.
     pub in_place_off: bool,
-    /// Edge-triangle crossing tests over all attempts (bounds the restarts' work).
-    pub crossing_tests: u64,
+    /// The work over all attempts ([`Cdt::work`]; bounds the restarts).
+    pub work: u64,
     /// Seconds for the Delaunay tetrahedralization.
     pub delaunay_secs: f64,
     /// Seconds for segment recovery.
@@ -215,7 +215,7 @@ const MAX_RETRY_TETS: usize = 4;
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 24;
 
-/// Crossing tests that restarts may spend beyond eight times the first attempt's.
+/// Work ([`Cdt::work`]) that restarts may spend beyond eight times the first attempt's.
 const RESTART_WORK: u64 = 20_000_000;
 
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
@@ -423,7 +423,7 @@ pub fn mesh_plc_with_progress(
             Attempt::Restart(more, splits) => {
                 stats.restarts += 1;
                 if stats.restarts == 1 {
-                    first_work = stats.crossing_tests;
+                    first_work = stats.work;
                 }
                 if debug() {
                     eprintln!("restart {}", stats.restarts);
@@ -434,7 +434,7 @@ pub fn mesh_plc_with_progress(
                 let over_work = stats.restarts > MAX_RESTARTS
                     || facet_points.len() + more.len() + presplits.len() + splits.len()
                         > max_facet_points(plc)
-                    || stats.crossing_tests > RESTART_WORK + 8 * first_work;
+                    || stats.work > RESTART_WORK + 8 * first_work;
                 if (over_steiner || over_work) && retry.is_some() {
                     retry_failed = true;
                     continue;
@@ -862,7 +862,7 @@ fn attempt(
         }
     }
     stats.facet_secs = t2.elapsed().as_secs_f64() - stats.surface_secs;
-    stats.crossing_tests += cdt.crossing_tests.get();
+    stats.work += cdt.work.get();
     // The carving of the CDT as it stands, while nothing changes it.
     let mut carved: Option<Carved> = None;
     if steiner.is_empty() && splits.is_empty() {
@@ -928,7 +928,7 @@ fn attempt(
                 .iter()
                 .filter(|p| !facet_points.iter().any(|(_, q)| q == *p))
                 .map(|&p| (FREE_POINT, p));
-            if stats.restarts < MAX_FREE_RESTARTS && stats.crossing_tests < RESTART_WORK / 4 {
+            if stats.restarts < MAX_FREE_RESTARTS && stats.work < RESTART_WORK / 4 {
                 steiner.extend(new);
             }
             break;
@@ -941,7 +941,7 @@ fn attempt(
         // Like free points, they only improve a valid CDT: only while the restart they
         // cost stays well within the bounds on restarts and their work.
         let affordable = stats.restarts < MAX_FREE_RESTARTS
-            && stats.crossing_tests < RESTART_WORK / 4
+            && stats.work < RESTART_WORK / 4
             && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
         if steiner.is_empty() && affordable {
             splits.extend(flat_tet_splits(&cdt, &stuck, &seg_of, &subsegs));

@@ -286,6 +286,9 @@ pub struct CompareCounts {
     pub exact: usize,
     /// Exact ties broken by the symbolic perturbation.
     pub perturbed: usize,
+    /// The size of the exact comparisons: for each, the product of the two sides'
+    /// component counts, which the cost of its multiplications follows.
+    pub exact_work: u64,
 }
 
 impl FlipTime {
@@ -424,6 +427,8 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
     counts.exact += 1;
     let (ea, eb) = (a.exact(lift), b.exact(lift));
     let (ia, ja, ib, jb) = (&ea.i, &ea.j, &eb.i, &eb.j);
+    let len = |x: &Expansion, y: &Expansion| (x.components().len() + y.components().len()) as u64;
+    counts.exact_work += len(ia, ja) * len(ib, jb);
     let s = ib.mul(ja).sub(&ia.mul(jb)).sign();
     if s != 0 {
         return s;
