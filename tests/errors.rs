@@ -300,6 +300,24 @@ fn fuzz_regression_far_corner_ends_flip_insertion_in_bounded_work() {
     }
 }
 
+/// Found by `tests/fuzz.rs`: a space inside a coordinate of `anchor.off` shifts every
+/// later coordinate by one, so the model gets a vertex 135,538 units out of a shape of
+/// size 1. The search for free points then walked to hundreds of thousands of candidate
+/// places, thousands of steps each, for two minutes; it now stops past a bound on its
+/// walks' steps, and the model meshes in about a second.
+#[test]
+fn fuzz_regression_free_point_walks_are_bounded() {
+    for algo in ["-pQ", "-pQF"] {
+        let (code, stderr) = mutated(
+            "nonflat/anchor.off",
+            "\n-0.345 0.135538 0.0217069\n",
+            "\n-0.345 0. 135538 0.0217069\n",
+            &[algo, "--check"],
+        );
+        assert_eq!(code, Some(0), "{algo}: {stderr}");
+    }
+}
+
 #[test]
 fn duplicate_facet_exits_3() {
     refused(

@@ -221,6 +221,11 @@ const RESTART_WORK: u64 = 20_000_000;
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
 const MAX_FREE_ROUNDS: usize = 12;
 
+/// Walk steps that the search for free points may take in one construction, per tet
+/// slot of the mesh and in all (the corpus takes at most 11 per slot, on `112544.off`).
+const FREE_WALK_STEPS_PER_SLOT: u64 = 64;
+const FREE_WALK_STEPS: u64 = 1_000_000;
+
 /// Restarts after which free points the CDT refuses and flat-tet splits no longer start
 /// the construction again: each costs a whole construction, and past a few they do not
 /// converge (on fans of needle triangles every restart finds new flat tets).
@@ -893,8 +898,13 @@ fn attempt(
         // none of a round's can does the construction start again with them.
         let search = search.get_or_insert_with(|| make_search(&cdt));
         let mut stuck = Vec::new();
+        // The search walks to every candidate place; around a vertex far out of the
+        // model's scale the walks grow long, and it gives up past this many steps.
+        let walk_limit = cdt.dt.walk_steps()
+            + FREE_WALK_STEPS_PER_SLOT * cdt.dt.mesh.num_slots() as u64
+            + FREE_WALK_STEPS;
         for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(&mut cdt, search, &mut carved);
+            let found = slivers::free_points(&mut cdt, search, &mut carved, walk_limit);
             flat_left = Some(found.found);
             let free = found.points;
             stuck = found.stuck;

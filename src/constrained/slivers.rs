@@ -326,11 +326,13 @@ pub(crate) fn flat_left(
 
 /// Free vertices that remove the tets lying on one facet, a list for each such tet, and
 /// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
-/// if made.
+/// if made. The search stops once the point-location walks reach `walk_limit` steps
+/// ([`Delaunay::walk_steps`](crate::delaunay::Delaunay::walk_steps)).
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     search: &Search<'_>,
     carved: &mut Option<Carved>,
+    walk_limit: u64,
 ) -> FlatTets {
     let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
         return FlatTets::default();
@@ -342,11 +344,14 @@ pub(crate) fn free_points(
         ..Default::default()
     };
     for (t, f, flat) in tets {
+        if cdt.dt.walk_steps() > walk_limit {
+            break;
+        }
         let Some(slab) = slabs[f as usize].as_ref() else {
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        let ws = remover(cdt, &kept, t, &p, flat, slab, slabs);
+        let ws = remover(cdt, &kept, t, flat, slab, slabs, walk_limit);
         // A flat tet with no point off every slab may still be split (see `mod.rs`)
         // if the checked points fail.
         if flat && ws.first().is_none_or(|c| c.checked) {
@@ -493,11 +498,12 @@ fn remover(
     cdt: &mut Cdt,
     kept: &[bool],
     tet: crate::mesh::TetId,
-    p: &[Point; 4],
     flat: bool,
     slab: &Slab,
     slabs: &[Option<Slab>],
+    walk_limit: u64,
 ) -> Vec<Candidate> {
+    let p = &cdt.dt.mesh.verts(tet).map(|x| cdt.dt.points[x as usize]);
     let mut found: Vec<Candidate> = Vec::new();
     let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
     if o == 0.0 {
@@ -568,6 +574,9 @@ fn remover(
                     };
                     if !off || !inside(&w) || found.iter().any(|c| c.at == w) {
                         continue;
+                    }
+                    if cdt.dt.walk_steps() > walk_limit {
+                        return found;
                     }
                     if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
                         found.push(Candidate {

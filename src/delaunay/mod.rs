@@ -49,6 +49,8 @@ pub struct Delaunay {
     /// A box holding every vertex, and the predicates' static error bounds for it.
     bbox: [Point; 2],
     filter: StaticFilter,
+    /// Steps taken by point-location walks so far (work that callers may bound).
+    walk_steps: u64,
 }
 
 /// What [`Delaunay::blocked_cavity`] found.
@@ -123,6 +125,7 @@ impl Delaunay {
             edges: EdgeTable::default(),
             bbox: [[0.0; 3]; 2],
             filter: StaticFilter::new(&[0.0; 3], &[0.0; 3]),
+            walk_steps: 0,
         };
         dt.set_bbox(crate::geom::bounding_box(&dt.points));
         // A DT of n random points has about 6.5 n tets; reserve to avoid regrowth.
@@ -259,6 +262,7 @@ impl Delaunay {
         loop {
             steps += 1;
             if steps > max_steps {
+                self.walk_steps += steps as u64;
                 return self.locate_by_scan(p);
             }
             let start = (self.next_rand() & 3) as usize;
@@ -283,6 +287,7 @@ impl Delaunay {
             }
             match next {
                 None => {
+                    self.walk_steps += steps as u64;
                     if on_boundary {
                         if let Some(&v) = self.mesh.verts(t).iter().find(|&&v| self.pt(v) == p) {
                             return Location::Vertex(v);
@@ -294,11 +299,18 @@ impl Delaunay {
                     t = f.tet();
                     from = f.face();
                     if self.mesh.is_ghost(t) {
+                        self.walk_steps += steps as u64;
                         return Location::Outside(t);
                     }
                 }
             }
         }
+    }
+
+    /// Steps taken by point-location walks so far (a scan past a walk's bound counts as
+    /// the walk's steps).
+    pub fn walk_steps(&self) -> u64 {
+        self.walk_steps
     }
 
     /// [`Delaunay::locate`] by testing every live tet: a real tet holding `p`, else a
