@@ -222,8 +222,9 @@ const RESTART_WORK: u64 = 20_000_000;
 const MAX_FREE_ROUNDS: usize = 12;
 
 /// Walk steps that the search for free points may take in one construction, per tet
-/// slot of the mesh and in all (the corpus takes at most 11 per slot, on `112544.off`).
+/// slot of the mesh (the corpus takes at most 11 per slot, on `112544.off`)...
 const FREE_WALK_STEPS_PER_SLOT: u64 = 64;
+/// ... and beyond those, for small meshes.
 const FREE_WALK_STEPS: u64 = 1_000_000;
 
 /// Restarts after which free points the CDT refuses and flat-tet splits no longer start
