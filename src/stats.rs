@@ -50,6 +50,10 @@ impl Stats {
                 "    flat tets left on one facet",
                 p.flat_tets_left.to_string(),
             ),
+            (
+                "    free-point searches cut short",
+                p.free_searches_cut.to_string(),
+            ),
             ("(4) output tetrahedra", p.output_tets.to_string()),
             ("(5) output subpolygons", p.output_subfaces.to_string()),
             (
@@ -160,12 +164,13 @@ impl Stats {
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 21] = [
+            let pairs: [(&str, String); 22] = [
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),
                 ("free_steiner_points", p.free_steiner_points.to_string()),
                 ("flat_tets_left", p.flat_tets_left.to_string()),
+                ("free_searches_cut", p.free_searches_cut.to_string()),
                 ("output_subfaces", p.output_subfaces.to_string()),
                 ("recovered_subfaces", p.recovered_subfaces.to_string()),
                 ("max_region_subfaces", p.max_region_subfaces.to_string()),

@@ -596,6 +596,7 @@ fn flat_tets_left_on_a_facet_are_counted_and_reported() {
     assert_eq!(code, 0, "{err}");
     let stats = std::fs::read_to_string(&json).unwrap();
     assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{stats}");
+    assert_eq!(json_number(&stats, "free_searches_cut"), 0, "{stats}");
     assert!(!err.contains("flat tet"), "{err}");
     let all = json_number(&stats, "steiner_points");
     let free = json_number(&stats, "free_steiner_points");

@@ -133,6 +133,9 @@ pub struct PlcStats {
     pub free_steiner_points: usize,
     /// Flat tets left with all four vertices on one facet (no free point removed them).
     pub flat_tets_left: usize,
+    /// Constructions whose search for free points stopped at its bound on work (around
+    /// vertices far out of the model's scale), leaving flat tets it did not get to.
+    pub free_searches_cut: usize,
     /// Output tets.
     pub output_tets: usize,
     /// Output subpolygons (triangles on input polygons).
@@ -221,11 +224,11 @@ const RESTART_WORK: u64 = 20_000_000;
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
 const MAX_FREE_ROUNDS: usize = 12;
 
-/// Walk steps that the search for free points may take in one construction, per tet
-/// slot of the mesh (the corpus takes at most 11 per slot, on `112544.off`)...
-const FREE_WALK_STEPS_PER_SLOT: u64 = 64;
-/// ... and beyond those, for small meshes.
-const FREE_WALK_STEPS: u64 = 1_000_000;
+/// Work ([`slivers::free_points`]) that the search for free points may do in one
+/// construction, per tet slot of the mesh (the corpus takes at most 17 per slot, on `112544.off`)...
+const FREE_SEARCH_WORK_PER_SLOT: u64 = 64;
+/// ... and beyond that, for small meshes.
+const FREE_SEARCH_WORK: u64 = 1_000_000;
 
 /// Restarts after which free points the CDT refuses and flat-tet splits no longer start
 /// the construction again: each costs a whole construction, and past a few they do not
@@ -475,10 +478,16 @@ pub fn mesh_plc_with_progress(
     let (flat, first) = built.flat_left;
     stats.flat_tets_left = flat;
     if let Some(f) = first.filter(|_| flat > 0) {
+        let why = if stats.free_searches_cut > 0 {
+            "which the search for free Steiner points, cut short at its bound on work (a \
+             vertex far out of the model's scale makes it long), did not remove"
+        } else {
+            "which no free Steiner point could remove"
+        };
         warnings.push(format!(
             "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
-             {}: steps or dents of facets that are not flat, which no free Steiner point \
-             could remove (checks for shim tets flag them)",
+             {}: steps or dents of facets that are not flat, {why} (checks for shim tets flag \
+             them)",
             facet_name(plc, &merged.facets[f as usize])
         ));
     }
@@ -899,13 +908,13 @@ fn attempt(
         // none of a round's can does the construction start again with them.
         let search = search.get_or_insert_with(|| make_search(&cdt));
         let mut stuck = Vec::new();
-        // The search walks to every candidate place; around a vertex far out of the
-        // model's scale the walks grow long, and it gives up past this many steps.
-        let walk_limit = cdt.dt.walk_steps()
-            + FREE_WALK_STEPS_PER_SLOT * cdt.dt.mesh.num_slots() as u64
-            + FREE_WALK_STEPS;
+        // The search tests candidate places against the slabs near them and walks to
+        // them; around a vertex far out of the model's scale the slabs' boxes grow and
+        // the walks get long, and it gives up past this much work.
+        let mut budget =
+            FREE_SEARCH_WORK_PER_SLOT * cdt.dt.mesh.num_slots() as u64 + FREE_SEARCH_WORK;
         for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(&mut cdt, search, &mut carved, walk_limit);
+            let found = slivers::free_points(&mut cdt, search, &mut carved, &mut budget);
             flat_left = Some(found.found);
             let free = found.points;
             stuck = found.stuck;
@@ -943,6 +952,9 @@ fn attempt(
                 steiner.extend(new);
             }
             break;
+        }
+        if budget == 0 {
+            stats.free_searches_cut += 1;
         }
         stats.steiner_points += stats.free_steiner_points;
 

@@ -326,13 +326,14 @@ pub(crate) fn flat_left(
 
 /// Free vertices that remove the tets lying on one facet, a list for each such tet, and
 /// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
-/// if made. The search stops once the point-location walks reach `walk_limit` steps
-/// ([`Delaunay::walk_steps`](crate::delaunay::Delaunay::walk_steps)).
+/// if made. The search stops once it has spent `budget`: a unit for each step of its
+/// point-location walks ([`Delaunay::walk_steps`](crate::delaunay::Delaunay::walk_steps))
+/// and for each slab a candidate place is tested against, both about 10 ns.
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     search: &Search<'_>,
     carved: &mut Option<Carved>,
-    walk_limit: u64,
+    budget: &mut u64,
 ) -> FlatTets {
     let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
         return FlatTets::default();
@@ -344,14 +345,14 @@ pub(crate) fn free_points(
         ..Default::default()
     };
     for (t, f, flat) in tets {
-        if cdt.dt.walk_steps() > walk_limit {
+        if *budget == 0 {
             break;
         }
         let Some(slab) = slabs[f as usize].as_ref() else {
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        let ws = remover(cdt, &kept, t, flat, slab, slabs, walk_limit);
+        let ws = remover(cdt, &kept, t, flat, slab, slabs, budget);
         // A flat tet with no point off every slab may still be split (see `mod.rs`)
         // if the checked points fail.
         if flat && ws.first().is_none_or(|c| c.checked) {
@@ -501,7 +502,7 @@ fn remover(
     flat: bool,
     slab: &Slab,
     slabs: &[Option<Slab>],
-    walk_limit: u64,
+    budget: &mut u64,
 ) -> Vec<Candidate> {
     let p = &cdt.dt.mesh.verts(tet).map(|x| cdt.dt.points[x as usize]);
     let mut found: Vec<Candidate> = Vec::new();
@@ -567,18 +568,17 @@ fn remover(
                     let w: Point = std::array::from_fn(|k| b[k] + s * frac * scale * d[k]);
                     // Off every facet's slab (near one it could form flat tets there),
                     // or, failing that, off the tet's own.
-                    let off = if strict {
-                        !near.iter().any(|s| s.holds(&w))
-                    } else {
-                        !slab.holds(&w)
-                    };
+                    let off = off_slabs(&w, &near, slab, strict, budget);
                     if !off || !inside(&w) || found.iter().any(|c| c.at == w) {
                         continue;
                     }
-                    if cdt.dt.walk_steps() > walk_limit {
+                    if *budget == 0 {
                         return found;
                     }
-                    if containing_tet_near(cdt, tet, &w).is_some_and(|t| kept[t as usize]) {
+                    let steps = cdt.dt.walk_steps();
+                    let holder = containing_tet_near(cdt, tet, &w);
+                    *budget = budget.saturating_sub(cdt.dt.walk_steps() - steps);
+                    if holder.is_some_and(|t| kept[t as usize]) {
                         found.push(Candidate {
                             at: w,
                             checked: !strict || !flat,
@@ -595,6 +595,19 @@ fn remover(
         }
     }
     found
+}
+
+/// Whether `w` lies off every slab of `near` (if `strict`; near one it could form flat
+/// tets there) or else off `own`, charging `budget` a unit for each slab it could test:
+/// around a far vertex every slab's box is near, and these tests alone took seconds.
+fn off_slabs(w: &Point, near: &[&Slab], own: &Slab, strict: bool, budget: &mut u64) -> bool {
+    let (off, tests) = if strict {
+        (!near.iter().any(|s| s.holds(w)), near.len())
+    } else {
+        (!own.holds(w), 1)
+    };
+    *budget = budget.saturating_sub(tests as u64);
+    off
 }
 
 /// The tet's circumcenter and radius, when they are finite.
@@ -635,6 +648,49 @@ fn longest_edge2(p: &[Point; 4]) -> f64 {
 mod tests {
     use super::*;
     use crate::geom::lcg;
+
+    #[test]
+    fn slab_tests_are_charged_to_the_search_budget() {
+        // Horizontal slabs 0.1 thick at heights 0, 1 and 2 over the unit square.
+        let slab = |z: f64| Slab {
+            normal: [0.0, 0.0, 1.0],
+            mean: [0.5, 0.5, z],
+            tol: 0.1,
+            lo: [0.0, 0.0, z],
+            hi: [1.0, 1.0, z],
+        };
+        let slabs = [slab(0.0), slab(1.0), slab(2.0)];
+        let near: Vec<&Slab> = slabs.iter().collect();
+        let mut budget = 10;
+        assert!(!off_slabs(
+            &[0.5, 0.5, 1.05],
+            &near,
+            &slabs[0],
+            true,
+            &mut budget
+        ));
+        assert_eq!(budget, 7);
+        assert!(off_slabs(
+            &[0.5, 0.5, 1.5],
+            &near,
+            &slabs[0],
+            true,
+            &mut budget
+        ));
+        assert_eq!(budget, 4);
+        assert!(off_slabs(
+            &[0.5, 0.5, 1.05],
+            &near,
+            &slabs[0],
+            false,
+            &mut budget
+        ));
+        assert_eq!(budget, 3);
+        for _ in 0..2 {
+            off_slabs(&[0.5, 0.5, 1.5], &near, &slabs[0], true, &mut budget);
+        }
+        assert_eq!(budget, 0);
+    }
 
     #[test]
     fn tets_in_a_slab_pass_the_thinness_bound_and_thick_ones_do_not() {
