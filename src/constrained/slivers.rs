@@ -328,7 +328,7 @@ pub(crate) fn flat_left(
 /// the flat tets they cannot remove. `carved` is the CDT's carving if known, and is set
 /// if made. The search stops once it has spent `budget`: a unit for each step of its
 /// point-location walks ([`Delaunay::walk_steps`](crate::delaunay::Delaunay::walk_steps))
-/// and for each slab a candidate place is tested against, both about 10 ns.
+/// and for each slab a candidate place is tested against.
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     search: &Search<'_>,
