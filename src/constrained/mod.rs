@@ -225,7 +225,8 @@ const RESTART_WORK: u64 = 20_000_000;
 const MAX_FREE_ROUNDS: usize = 12;
 
 /// Work ([`slivers::free_points`]) that the search for free points may do in one
-/// construction, per tet slot of the mesh (the corpus takes at most 17 per slot, on `112544.off`)...
+/// construction, per tet slot of the mesh (the corpus takes at most 17 per slot, on
+/// `112544.off`)...
 const FREE_SEARCH_WORK_PER_SLOT: u64 = 64;
 /// ... and beyond that, for small meshes.
 const FREE_SEARCH_WORK: u64 = 1_000_000;

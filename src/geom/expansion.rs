@@ -310,8 +310,8 @@ mod tests {
         }
     }
 
-    /// A power of a value whose parts are 2^66 apart in scale stays a handful of components, where
-    /// keeping every roundoff made it grow with each multiplication.
+    /// The 11th power of a value whose two parts are 2^66 apart in scale stays short (219
+    /// components when every roundoff was kept).
     #[test]
     fn products_of_spread_out_values_stay_short() {
         let x = Expansion::diff(1.8e19, 0.29389262614623657);
@@ -324,7 +324,7 @@ mod tests {
             "{} components",
             p.components().len()
         );
-        // x^11 / x^11 computed the other way round agrees exactly.
+        // x^11 multiplied in the other order is exactly the same number.
         let mut q = x.clone();
         for _ in 0..10 {
             q = x.mul(&q);
