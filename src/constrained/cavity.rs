@@ -551,10 +551,19 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     if v[3] == GHOST {
         return false;
     }
+    let adaptive = crate::geom::predicates::adaptive_orient3d_calls();
+    let crossed = region.crossed_by_tet(&cdt.dt.points, v);
+    // A test is cheap unless its orientations need adaptive arithmetic: around a vertex
+    // far out of the model's scale they all do, and those count as the time they take.
+    let slow = crate::geom::predicates::adaptive_orient3d_calls() - adaptive;
     let work = &cdt.work;
-    work.set(work.get() + region.tris.len() as u64);
-    region.crossed_by_tet(&cdt.dt.points, v)
+    work.set(work.get() + region.tris.len() as u64 + ADAPTIVE_WORK_UNITS * slow);
+    crossed
 }
+
+/// Work units ([`Cdt::work`], a crossing test each) per orientation test that needed
+/// adaptive arithmetic.
+const ADAPTIVE_WORK_UNITS: u64 = 32;
 
 /// The stamp after `now` for arrays whose entries are valid where they carry the current
 /// stamp: when the numbers wrap, every entry's stamp (`stamp_of`) is cleared first, so

@@ -739,9 +739,12 @@ fn attempt(
                     let room = stats.steiner_points < opts.max_steiner
                         && placed_on_facets < max_facet_points(plc);
                     let asked = in_place_for.entry(p.map(f64::to_bits)).or_insert(0);
+                    // Updates are meant to be cheaper than a restart: not once this
+                    // construction has done a restart's worth of work.
                     let update = !stats.in_place_off
                         && in_place < MAX_IN_PLACE
-                        && *asked < MAX_IN_PLACE_EACH;
+                        && *asked < MAX_IN_PLACE_EACH
+                        && stats.work + cdt.work.get() < RESTART_WORK / 4;
                     *asked += 1;
                     if room {
                         let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));

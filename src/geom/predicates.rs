@@ -66,7 +66,20 @@ pub fn orient3d(a: &Point, b: &Point, c_: &Point, d: &Point) -> f64 {
     if let Some(det) = super::fixed::orient3d(a, b, c_, d) {
         return -det;
     }
+    ADAPTIVE_ORIENT3D.with(|n| n.set(n.get() + 1));
     -robust::orient3d(c(a), c(b), c(c_), c(d))
+}
+
+thread_local! {
+    /// [`orient3d`] calls on this thread that neither the filter nor the fixed-point path
+    /// settled: near-degenerate points whose coordinates span too many binary orders.
+    static ADAPTIVE_ORIENT3D: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// How many [`orient3d`] calls on this thread so far needed Shewchuk's adaptive stages
+/// (costly: around a vertex 1e20 away from a model of size 10, nearly all of them).
+pub fn adaptive_orient3d_calls() -> u64 {
+    ADAPTIVE_ORIENT3D.with(|n| n.get())
 }
 
 /// [`orient3d`]'s sign when its floating-point filter settles it (`None` where only
@@ -343,6 +356,30 @@ pub(crate) fn perturbed_sign<T: Copy, const N: usize, const M: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn orientations_that_need_adaptive_arithmetic_are_counted() {
+        let n0 = adaptive_orient3d_calls();
+        // Settled by the filter.
+        orient3d(
+            &[0.0; 3],
+            &[1.0, 0.0, 0.0],
+            &[0.0, 1.0, 0.0],
+            &[0.0, 0.0, 1.0],
+        );
+        assert_eq!(adaptive_orient3d_calls(), n0);
+        // Coplanar, with coordinates 2^66 apart in scale: neither the filter nor the
+        // fixed-point path settles it.
+        let far = 1.8e19;
+        let s = orient3d(
+            &[0.1, 0.0, 0.0],
+            &[0.0, 0.3, 0.0],
+            &[far, 0.0, 0.0],
+            &[0.0, far, 0.0],
+        );
+        assert_eq!(s, 0.0);
+        assert_eq!(adaptive_orient3d_calls(), n0 + 1);
+    }
 
     #[test]
     fn small_integer_insphere_agrees_with_the_adaptive_one() {
