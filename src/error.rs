@@ -78,6 +78,10 @@ pub enum MeshError {
     /// An internal consistency check failed; this is a bug.
     #[error("internal error: {0}")]
     Internal(String),
+    /// A construction passed its bound on work ([`crate::constrained::cdt::Cdt::work_limit`]):
+    /// the restarts end as if it had finished over the bound.
+    #[error("the construction passed its bound on work")]
+    WorkBound,
 }
 
 /// Any error of the library.

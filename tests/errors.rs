@@ -300,6 +300,28 @@ fn fuzz_regression_far_corner_ends_flip_insertion_in_bounded_work() {
     }
 }
 
+/// Found by `tests/fuzz.rs`: `cosph_hull.poly` with a vertex moved 1.8e20 away. Every
+/// orientation around it needs adaptive arithmetic, and after two restarts one
+/// construction spent close to a minute (`-F`; 20 s with `-C`) on the crossing tests of
+/// single regions, work that the bound on restarts saw only when the construction
+/// ended. A construction now stops where that bound would end the restarts.
+#[test]
+fn fuzz_regression_one_construction_stops_at_the_restarts_bound() {
+    for algo in ["-pQF", "-pQ"] {
+        let (code, stderr) = mutated(
+            "plc/cosph_hull.poly",
+            "\n26 1 -1 -5\n",
+            "\n26 1 -1 -184467440737095516165\n",
+            &[algo],
+        );
+        assert_eq!(code, Some(1), "{algo}: {stderr}");
+        assert!(
+            stderr.contains("polygons that are not flat still conflict after"),
+            "{algo}: {stderr}"
+        );
+    }
+}
+
 /// Found by `tests/fuzz.rs`: a space inside a coordinate of `anchor.off` shifts every
 /// later coordinate by one, so the model gets a vertex 135,538 units out of a shape of
 /// size 1. The search for free points then walked to hundreds of thousands of candidate

@@ -63,7 +63,7 @@ pub fn insert_region(
     normal: [f64; 3],
 ) -> Result<Outcome, MeshError> {
     let region = Region::new(cdt, tris);
-    let mut cavity = crossing_tets(cdt, &region);
+    let mut cavity = crossing_tets(cdt, &region)?;
     if cavity.is_empty() {
         // No tet crosses the region, yet its triangles are missing: the mesh already
         // triangulates the (not exactly flat) region its own way, which is as good a
@@ -641,7 +641,8 @@ impl Drop for SlotSet {
 
 /// The tets whose interiors meet the region: those with an edge crossing it. They are
 /// face-connected, and each touches the region near a region vertex or is reached from one.
-pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
+/// Stops with [`MeshError::WorkBound`] once the tests pass [`Cdt::work_limit`].
+pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Result<Vec<TetId>, MeshError> {
     let mut seen = SlotSet::new(cdt.dt.mesh.num_slots());
     let mut out = Vec::new();
     let mut star = Vec::new();
@@ -654,6 +655,7 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
                 out.push(t);
             }
         }
+        over_work(cdt)?;
     }
     let mut k = 0;
     while k < out.len() {
@@ -665,8 +667,17 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Vec<TetId> {
                 out.push(n);
             }
         }
+        over_work(cdt)?;
     }
-    out
+    Ok(out)
+}
+
+/// [`MeshError::WorkBound`] once the work done passes the construction's bound.
+pub(crate) fn over_work(cdt: &Cdt) -> Result<(), MeshError> {
+    if cdt.work.get() > cdt.work_limit {
+        return Err(MeshError::WorkBound);
+    }
+    Ok(())
 }
 
 /// Splits the cavity's boundary faces into those above and those below the region, by a
@@ -1264,5 +1275,35 @@ mod tests {
             assert_eq!(region.crossed_by_tet(&cdt.dt.points, v), want, "{v:?}");
         }
         assert!(crossing > 10 * ring.min(10), "{crossing}");
+    }
+
+    /// The crossing tets of a region are found in full under no bound, and the search
+    /// stops with [`MeshError::WorkBound`] once its tests pass the CDT's bound.
+    #[test]
+    fn crossing_tets_stop_at_the_work_limit() {
+        let mut s = 11u64;
+        let pts: Vec<Point> = (0..300)
+            .map(|_| [0, 0, 0].map(|_| 2.0 * lcg(&mut s) - 1.0))
+            .chain([[-3.0, -3.0, 0.01], [3.0, -3.0, -0.01], [0.0, 3.0, 0.02]])
+            .collect();
+        let dt = Delaunay::build(&pts).unwrap().dt;
+        let inv = dt.internal_ids(pts.len());
+        let mut cdt = Cdt::new(dt);
+        let tris = vec![[inv[300], inv[301], inv[302]]];
+        let region = Region::new(&cdt, &tris);
+        let all = crossing_tets(&mut cdt, &region).unwrap();
+        let spent = cdt.work.get();
+        assert!(
+            all.len() > 50 && spent as usize >= all.len(),
+            "{} {spent}",
+            all.len()
+        );
+        cdt.work.set(0);
+        cdt.work_limit = spent / 2;
+        assert!(matches!(
+            crossing_tets(&mut cdt, &region),
+            Err(MeshError::WorkBound)
+        ));
+        assert!(cdt.work.get() < spent, "stopped early");
     }
 }

@@ -39,6 +39,9 @@ pub struct Cdt {
     /// The work done so far, which bounds restarts: edge-triangle crossing tests, and
     /// exact flip-time comparisons in units of about the same cost.
     pub work: std::cell::Cell<u64>,
+    /// The work past which the construction stops ([`crate::error::MeshError::WorkBound`]): a single
+    /// region can cost more than all restarts may, around a vertex far out of scale.
+    pub work_limit: u64,
 }
 
 impl Cdt {
@@ -51,6 +54,7 @@ impl Cdt {
             face_index: FxHashMap::default(),
             scratch: Vec::new(),
             work: std::cell::Cell::new(0),
+            work_limit: u64::MAX,
         }
     }
 

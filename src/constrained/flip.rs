@@ -254,7 +254,7 @@ pub fn insert_region(
     total: &mut FlipCounts,
 ) -> Result<Outcome, MeshError> {
     let region = Region::new(cdt, tris);
-    let crossing = crossing_tets(cdt, &region);
+    let crossing = crossing_tets(cdt, &region)?;
     if crossing.is_empty() {
         // Nothing to flip: the cavity code adopts the mesh's own faces or asks for a point.
         return cavity::insert_region(cdt, tris, facet, normal);
@@ -675,6 +675,11 @@ impl<'a> Flipper<'a> {
                 flips += 1;
                 if flips > budget {
                     return Ok(false);
+                }
+                if self.cdt.work.get() + EXACT_WORK_UNITS * self.cmp.exact_work
+                    > self.cdt.work_limit
+                {
+                    return Err(MeshError::WorkBound);
                 }
                 match self.try_flip(self.events[e as usize].face, false)? {
                     Ok(new) => {

@@ -236,6 +236,15 @@ const FREE_SEARCH_WORK: u64 = 1_000_000;
 /// converge (on fans of needle triangles every restart finds new flat tets).
 const MAX_FREE_RESTARTS: usize = 3;
 
+/// The error of restarts that end over their bounds, after `points` Steiner points on
+/// polygons.
+fn still_conflicting(points: usize) -> Error {
+    MeshError::Failed(format!(
+        "polygons that are not flat still conflict after {points} Steiner points on them"
+    ))
+    .into()
+}
+
 /// The state to start the constructions over from, with updates in place turned off
 /// (`stats0` as at the start): no points from earlier attempts, no work done.
 fn without_updates(stats0: &PlcStats) -> (Vec<FacetPoint>, Vec<SegmentSplit>, u64, PlcStats) {
@@ -352,13 +361,20 @@ pub fn mesh_plc_with_progress(
         }
         opts.check_cancel()?;
         let prep = split.as_ref().unwrap_or(&base);
+        // A construction after the first stops where the restarts' bound would end it
+        // anyway: one region around a far vertex can cost minutes.
+        let work_limit = if stats.restarts == 0 {
+            u64::MAX
+        } else {
+            (RESTART_WORK + 8 * first_work).saturating_sub(stats.work)
+        };
         let result = match attempt(
             plc,
             first_dt.take(),
             [prep, merged],
             (&facet_points, &presplits),
             opts,
-            &mut stats,
+            (&mut stats, work_limit),
             progress,
         ) {
             Err(Error::Mesh(MeshError::Failed(msg)))
@@ -398,6 +414,9 @@ pub fn mesh_plc_with_progress(
                 (facet_points, presplits, first_work, stats) = without_updates(&stats0);
                 continue;
             }
+            Err(Error::Mesh(MeshError::WorkBound)) => {
+                return Err(still_conflicting(facet_points.len()));
+            }
             Err(e) => return Err(e),
         };
         match outcome {
@@ -436,7 +455,10 @@ pub fn mesh_plc_with_progress(
                     first_work = stats.work;
                 }
                 if debug() {
-                    eprintln!("restart {}", stats.restarts);
+                    eprintln!(
+                        "restart {} work {} first {}",
+                        stats.restarts, stats.work, first_work
+                    );
                 }
                 let over_steiner = facet_points.len() + more.len() > opts.max_steiner;
                 // Restarts may cost far more than the first attempt when the polygons'
@@ -461,11 +483,7 @@ pub fn mesh_plc_with_progress(
                     .into());
                 }
                 if over_work {
-                    return Err(MeshError::Failed(format!(
-                        "polygons that are not flat still conflict after {} Steiner points on them",
-                        facet_points.len()
-                    ))
-                    .into());
+                    return Err(still_conflicting(facet_points.len()));
                 }
                 facet_points.extend(more);
                 presplits.extend(splits);
@@ -567,7 +585,7 @@ fn attempt(
     [prep, merged]: [&PreparedPlc; 2],
     (facet_points, presplits): (&[FacetPoint], &[SegmentSplit]),
     opts: &PlcOptions,
-    stats: &mut PlcStats,
+    (stats, work_limit): (&mut PlcStats, u64),
     progress: Progress<'_>,
 ) -> Result<Attempt, Error> {
     let n_input = plc.points.len();
@@ -650,6 +668,7 @@ fn attempt(
         .map(|t| face_key(*t))
         .collect();
     let mut cdt = Cdt::new(dt);
+    cdt.work_limit = work_limit;
     cdt.index_faces_of(&wanted);
     cdt.subfaces.reserve(wanted.len());
     let mut splits: Vec<(usize, f64)> = Vec::new();
