@@ -166,6 +166,17 @@ fn polygon_far_from_flat_exits_3() {
 /// Runs `tetcdt ARGS` on a copy of `data/MODEL` whose first `from` becomes `to` (one of
 /// the fuzzer's mutations); returns the exit code and stderr.
 fn mutated(model: &str, from: &str, to: &str, args: &[&str]) -> (Option<i32>, String) {
+    mutated_traced(model, from, to, args, false)
+}
+
+/// [`mutated`], with the mesher's trace (`TETCDT_DEBUG`) on stderr if `trace`.
+fn mutated_traced(
+    model: &str,
+    from: &str,
+    to: &str,
+    args: &[&str],
+    trace: bool,
+) -> (Option<i32>, String) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("data")
         .join(model);
@@ -174,8 +185,13 @@ fn mutated(model: &str, from: &str, to: &str, args: &[&str]) -> (Option<i32>, St
     let name = path.file_name().unwrap();
     let dir = tempfile::tempdir().unwrap();
     fs::write(dir.path().join(name), text.replacen(from, to, 1)).unwrap();
-    let out = Command::cargo_bin("tetcdt")
-        .unwrap()
+    let mut cmd = Command::cargo_bin("tetcdt").unwrap();
+    if trace {
+        cmd.env("TETCDT_DEBUG", "1");
+    } else {
+        cmd.env_remove("TETCDT_DEBUG");
+    }
+    let out = cmd
         .current_dir(dir.path())
         .args(args)
         .arg(name)
@@ -320,6 +336,30 @@ fn fuzz_regression_one_construction_stops_at_the_restarts_bound() {
             "{algo}: {stderr}"
         );
     }
+}
+
+/// Found by a search like the fuzzer's: a corner of the 40-gon prism moved 3.4e38 away.
+/// The first construction updates the CDT in place, and those updates cost more than the
+/// bound on restarts allows; they stop there (the trace says so), and the constructions
+/// start over without updates (0.8 s in all; 2.8 s before).
+#[test]
+fn updates_in_place_of_the_first_construction_stop_at_the_restarts_bound() {
+    let (code, stderr) = mutated_traced(
+        "plc/prism_n40_d1e-5_s1.poly",
+        "\n70 0 -0.49999 0.5000072385547387\n",
+        "\n70 0 -0.49999 3.4e38\n",
+        &["-pQF"],
+        true,
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("restart 0 without updates in place: the construction passed its bound"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("polygons that are not flat still conflict after"),
+        "{stderr}"
+    );
 }
 
 /// Found by `tests/fuzz.rs`: a space inside a coordinate of `anchor.off` shifts every

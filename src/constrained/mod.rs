@@ -410,7 +410,10 @@ pub fn mesh_plc_with_progress(
             }
             // Updates in place may lead a construction astray where restarts would
             // not: it is done again without them.
-            Err(_) if stats.in_place_splits > 0 && !stats.in_place_off => {
+            Err(e) if stats.in_place_splits > 0 && !stats.in_place_off => {
+                if debug() {
+                    eprintln!("restart {} without updates in place: {e}", stats.restarts);
+                }
                 (facet_points, presplits, first_work, stats) = without_updates(&stats0);
                 continue;
             }
@@ -865,6 +868,12 @@ fn attempt(
                             stats.steiner_points += 1;
                             stats.in_place_splits += 1;
                             in_place += 1;
+                            if in_place == 1 {
+                                // Updates stand in for restarts, and are bounded as
+                                // they are, by the work done before the first one.
+                                let before = cdt.work.get();
+                                cdt.work_limit = cdt.work_limit.min(RESTART_WORK + 9 * before);
+                            }
                             retriangulate.extend(facets);
                             retriangulate.push(fi);
                             break;
