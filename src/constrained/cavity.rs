@@ -673,7 +673,7 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Result<Vec<TetId>
 }
 
 /// [`MeshError::WorkBound`] once the work done passes the construction's bound.
-pub(crate) fn over_work(cdt: &Cdt) -> Result<(), MeshError> {
+fn over_work(cdt: &Cdt) -> Result<(), MeshError> {
     if cdt.work.get() > cdt.work_limit {
         return Err(MeshError::WorkBound);
     }

@@ -36,11 +36,13 @@ pub struct Cdt {
     /// hint that [`Cdt::has_face`] confirms in constant time while that tet is unchanged.
     face_index: FxHashMap<[VertexId; 3], FaceRef>,
     scratch: Vec<TetId>,
-    /// The work done so far, which bounds restarts: edge-triangle crossing tests, and
-    /// exact flip-time comparisons in units of about the same cost.
+    /// The work done so far, which bounds restarts: edge-triangle crossing tests (and
+    /// their orientations that need adaptive arithmetic), and exact flip-time
+    /// comparisons, in units of about the same cost.
     pub work: std::cell::Cell<u64>,
-    /// The work past which the construction stops ([`crate::error::MeshError::WorkBound`]): a single
-    /// region can cost more than all restarts may, around a vertex far out of scale.
+    /// The work past which the construction stops
+    /// ([`crate::error::MeshError::WorkBound`]): a single region can cost more than all
+    /// restarts may, around a vertex far out of scale.
     pub work_limit: u64,
 }
 
