@@ -301,13 +301,18 @@ fn fuzz_regression_updates_in_place_fall_back_to_restarts() {
 /// now count too (and products are compressed), and the run ends within seconds.
 #[test]
 fn fuzz_regression_far_corner_ends_flip_insertion_in_bounded_work() {
+    refused_at_the_restarts_bound(
+        "plc/prism_n40_d1e-5_s1.poly",
+        "\n6 0.29389262614623657 0.4045084971874737 -0.5000067566867479\n",
+        "\n6 0.29389262614623657 0.4045084971874737 -18446744073709551616\n",
+    );
+}
+
+/// Asserts that both algorithms refuse the mutated model (see [`mutated`]) at the bound
+/// on restarts, within the hang guard.
+fn refused_at_the_restarts_bound(model: &str, from: &str, to: &str) {
     for algo in ["-pQF", "-pQ"] {
-        let (code, stderr) = mutated(
-            "plc/prism_n40_d1e-5_s1.poly",
-            "\n6 0.29389262614623657 0.4045084971874737 -0.5000067566867479\n",
-            "\n6 0.29389262614623657 0.4045084971874737 -18446744073709551616\n",
-            &[algo],
-        );
+        let (code, stderr) = mutated(model, from, to, &[algo]);
         assert_eq!(code, Some(1), "{algo}: {stderr}");
         assert!(
             stderr.contains("polygons that are not flat still conflict after"),
@@ -323,19 +328,11 @@ fn fuzz_regression_far_corner_ends_flip_insertion_in_bounded_work() {
 /// ended. A construction now stops where that bound would end the restarts.
 #[test]
 fn fuzz_regression_one_construction_stops_at_the_restarts_bound() {
-    for algo in ["-pQF", "-pQ"] {
-        let (code, stderr) = mutated(
-            "plc/cosph_hull.poly",
-            "\n26 1 -1 -5\n",
-            "\n26 1 -1 -184467440737095516165\n",
-            &[algo],
-        );
-        assert_eq!(code, Some(1), "{algo}: {stderr}");
-        assert!(
-            stderr.contains("polygons that are not flat still conflict after"),
-            "{algo}: {stderr}"
-        );
-    }
+    refused_at_the_restarts_bound(
+        "plc/cosph_hull.poly",
+        "\n26 1 -1 -5\n",
+        "\n26 1 -1 -184467440737095516165\n",
+    );
 }
 
 /// Found by a search like the fuzzer's: a corner of the 40-gon prism moved 3.4e38 away.
