@@ -14,6 +14,7 @@
 use super::cdt::{face_key, Cdt};
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
+use crate::geom::predicates::adaptive_orient3d_calls;
 use crate::geom::{orient3d, Point};
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS as EDGES, FACE_VERTS, GHOST};
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -551,14 +552,9 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     if v[3] == GHOST {
         return false;
     }
-    let adaptive = crate::geom::predicates::adaptive_orient3d_calls();
-    let crossed = region.crossed_by_tet(&cdt.dt.points, v);
-    // A test is cheap unless its orientations need adaptive arithmetic: around a vertex
-    // far out of the model's scale they all do, and those count as the time they take.
-    let slow = crate::geom::predicates::adaptive_orient3d_calls() - adaptive;
     let work = &cdt.work;
-    work.set(work.get() + region.tris.len() as u64 + ADAPTIVE_WORK_UNITS * slow);
-    crossed
+    work.set(work.get() + region.tris.len() as u64);
+    region.crossed_by_tet(&cdt.dt.points, v)
 }
 
 /// Work units ([`Cdt::work`], a crossing test each) per orientation test that needed
@@ -643,6 +639,7 @@ impl Drop for SlotSet {
 /// face-connected, and each touches the region near a region vertex or is reached from one.
 /// Stops with [`MeshError::WorkBound`] once the tests pass [`Cdt::work_limit`].
 pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Result<Vec<TetId>, MeshError> {
+    let mut adaptive = adaptive_orient3d_calls();
     let mut seen = SlotSet::new(cdt.dt.mesh.num_slots());
     let mut out = Vec::new();
     let mut star = Vec::new();
@@ -655,7 +652,7 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Result<Vec<TetId>
                 out.push(t);
             }
         }
-        over_work(cdt)?;
+        over_work(cdt, &mut adaptive)?;
     }
     let mut k = 0;
     while k < out.len() {
@@ -667,14 +664,22 @@ pub(crate) fn crossing_tets(cdt: &mut Cdt, region: &Region) -> Result<Vec<TetId>
                 out.push(n);
             }
         }
-        over_work(cdt)?;
+        over_work(cdt, &mut adaptive)?;
     }
     Ok(out)
 }
 
-/// [`MeshError::WorkBound`] once the work done passes the construction's bound.
-fn over_work(cdt: &Cdt) -> Result<(), MeshError> {
-    if cdt.work.get() > cdt.work_limit {
+/// Charges the crossing tests' orientations since `adaptive` (a count of
+/// [`adaptive_orient3d_calls`]) that needed adaptive arithmetic, then fails with
+/// [`MeshError::WorkBound`] once the work done passes the construction's bound. A test is
+/// cheap unless its orientations need adaptive arithmetic: around a vertex far out of
+/// the model's scale they all do, and those count as the time they take.
+fn over_work(cdt: &Cdt, adaptive: &mut u64) -> Result<(), MeshError> {
+    let now = adaptive_orient3d_calls();
+    let work = &cdt.work;
+    work.set(work.get() + ADAPTIVE_WORK_UNITS * (now - *adaptive));
+    *adaptive = now;
+    if work.get() > cdt.work_limit {
         return Err(MeshError::WorkBound);
     }
     Ok(())

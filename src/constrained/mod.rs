@@ -221,6 +221,12 @@ const MAX_RESTARTS: usize = 24;
 /// Work ([`Cdt::work`]) that restarts may spend beyond eight times the first attempt's.
 const RESTART_WORK: u64 = 20_000_000;
 
+/// The work all restarts may do, by the first construction's `first` (see
+/// [`RESTART_WORK`]).
+fn restart_work_bound(first: u64) -> u64 {
+    RESTART_WORK + 8 * first
+}
+
 /// Restarts after which flat tets no longer get free points (see [`slivers`]).
 const MAX_FREE_ROUNDS: usize = 12;
 
@@ -366,7 +372,7 @@ pub fn mesh_plc_with_progress(
         let work_limit = if stats.restarts == 0 {
             u64::MAX
         } else {
-            (RESTART_WORK + 8 * first_work).saturating_sub(stats.work)
+            restart_work_bound(first_work).saturating_sub(stats.work)
         };
         let result = match attempt(
             plc,
@@ -469,7 +475,7 @@ pub fn mesh_plc_with_progress(
                 let over_work = stats.restarts > MAX_RESTARTS
                     || facet_points.len() + more.len() + presplits.len() + splits.len()
                         > max_facet_points(plc)
-                    || stats.work > RESTART_WORK + 8 * first_work;
+                    || stats.work > restart_work_bound(first_work);
                 if (over_steiner || over_work) && retry.is_some() {
                     retry_failed = true;
                     continue;
@@ -872,7 +878,8 @@ fn attempt(
                                 // Updates stand in for restarts, and are bounded as
                                 // they are, by the work done before the first one.
                                 let before = cdt.work.get();
-                                cdt.work_limit = cdt.work_limit.min(RESTART_WORK + 9 * before);
+                                cdt.work_limit =
+                                    cdt.work_limit.min(before + restart_work_bound(before));
                             }
                             retriangulate.extend(facets);
                             retriangulate.push(fi);

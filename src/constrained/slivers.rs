@@ -352,7 +352,7 @@ pub(crate) fn free_points(
             continue;
         };
         let p = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-        let ws = remover(cdt, &kept, t, flat, slab, slabs, budget);
+        let ws = remover(cdt, &kept, (t, &p), flat, slab, slabs, budget);
         // A flat tet with no point off every slab may still be split (see `mod.rs`)
         // if the checked points fail.
         if flat && ws.first().is_none_or(|c| c.checked) {
@@ -498,13 +498,12 @@ const CANDIDATES: usize = 6;
 fn remover(
     cdt: &mut Cdt,
     kept: &[bool],
-    tet: crate::mesh::TetId,
+    (tet, p): (crate::mesh::TetId, &[Point; 4]),
     flat: bool,
     slab: &Slab,
     slabs: &[Option<Slab>],
     budget: &mut u64,
 ) -> Vec<Candidate> {
-    let p = &cdt.dt.mesh.verts(tet).map(|x| cdt.dt.points[x as usize]);
     let mut found: Vec<Candidate> = Vec::new();
     let o = orient3d(&p[0], &p[1], &p[2], &p[3]);
     if o == 0.0 {
