@@ -12,7 +12,9 @@
 //! outside R is refused; non-crossing faces next to new non-crossing tets are checked for
 //! local regularity and flipped if needed; a flip that cannot be done yet waits in a list
 //! L and is retried after every flip. If the region is still missing when the queue runs
-//! dry, the region falls back to cavity retriangulation, which is counted and reported.
+//! dry, the region falls back to cavity retriangulation, which is counted and reported;
+//! but a polygon that is not flat, whose vertices off the lifting plane break the order
+//! the flips rely on, gets a Steiner point instead, the flips taken back first.
 //!
 //! After the region is in, the weights are restored: faces in R that are not locally
 //! Delaunay (polygons that are not exactly flat) are repaired by flips where possible,
@@ -23,6 +25,7 @@ use super::bistellar::{self, Few, Kind};
 use super::cavity::{self, crossing_tets, steiner_point, Outcome, Region, RegionStats};
 use super::cdt::{edge_key, face_key, Cdt};
 use super::flip_queue::{FlipQueue, Interval, Order};
+use crate::delaunay::Change;
 use crate::error::MeshError;
 use crate::geom::lifted::{cross_sign, Approx, CompareCounts, FlipTime, Lifting};
 use crate::geom::{cross, dot, insphere_sos, sub, Point, Sign};
@@ -54,6 +57,10 @@ pub struct FlipCounts {
     /// recovered (near-shims, another triangulation of the polygon): handed to the
     /// cavity code, which adopts the triangulation or places a Steiner point.
     pub not_flat_handovers: usize,
+    /// Regions of polygons that are not flat whose flips got stuck with crossing tets
+    /// left: the flips were taken back and the region asked for a Steiner point on the
+    /// polygon, as the paper does for the other troubles of such polygons.
+    pub not_flat_stuck: usize,
     /// Flip-time comparisons that needed exact arithmetic.
     pub exact_compares: usize,
     /// Of those, exact ties broken by the symbolic perturbation.
@@ -73,6 +80,7 @@ impl FlipCounts {
         self.constrained += o.constrained;
         self.fallbacks += o.fallbacks;
         self.not_flat_handovers += o.not_flat_handovers;
+        self.not_flat_stuck += o.not_flat_stuck;
         self.exact_compares += o.exact_compares;
         self.perturbed_compares += o.perturbed_compares;
     }
@@ -266,7 +274,9 @@ pub fn insert_region(
         .verts
         .iter()
         .all(|&v| lift.side(&cdt.dt.points[v as usize]) == 0);
-    let mut fl = Flipper::new(cdt, &region, lift, &crossing);
+    // Where the polygon is not flat, the flips are recorded, to be taken back if they
+    // get stuck.
+    let mut fl = Flipper::new(cdt, &region, lift, &crossing, !flat);
     let done = fl.run()?;
     let problem = if done {
         fl.repair(flat)?
@@ -288,6 +298,8 @@ pub fn insert_region(
     counts.add(&here);
     let mut at_risk = std::mem::take(&mut fl.at_risk);
     let crossing_left = fl.crossing_left;
+    let stuck_near = std::mem::take(&mut fl.stuck_near);
+    let journal = fl.journal.take();
     drop(fl);
     if debug() {
         eprintln!(
@@ -299,8 +311,34 @@ pub fn insert_region(
     }
     match problem {
         None => {}
+        Some(Problem::Stuck) if !flat && crossing_left > 0 => {
+            // The weights order the flips as if the polygon's vertices lay on the lifting
+            // plane; off it, the flips can get stuck. The mesh goes back to the CDT it was
+            // and the polygon gets a point near the crossing tets left, where the cavity
+            // code would put it for a shim, so the next try has smaller, flatter pieces.
+            if let Some(changes) = journal {
+                cdt.dt.undo_changes(&changes);
+            }
+            counts.not_flat_stuck += 1;
+            let near = tris
+                .iter()
+                .max_by_key(|t| t.iter().filter(|x| stuck_near.contains(x)).count())
+                .copied()
+                .unwrap_or(tris[0]);
+            if debug() {
+                eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, Steiner point near {near:?}");
+            }
+            return Ok(Outcome::NeedsSteiner(steiner_point(
+                cdt, tris, near, normal,
+            )));
+        }
         Some(Problem::Shim(f)) | Some(Problem::NotDelaunay(f)) if !flat => {
-            // The point goes on the polygon, at the region triangle nearest the trouble.
+            // The point goes on the polygon, at the region triangle nearest the trouble,
+            // into the CDT as it was: the flips are taken back, so that no face is left
+            // that is not locally Delaunay, and no subface of another facet is lost.
+            if let Some(changes) = journal {
+                cdt.dt.undo_changes(&changes);
+            }
             let near = tris
                 .iter()
                 .max_by_key(|t| t.iter().filter(|x| f.contains(x)).count())
@@ -609,10 +647,20 @@ struct Flipper<'a> {
     cover_head: Vec<u32>,
     /// Crossing tets (a left and a right vertex) left when the queue ran dry.
     crossing_left: usize,
+    /// The vertices of those tets.
+    stuck_near: Vec<VertexId>,
+    /// Every flip made, oldest first, when they may have to be taken back.
+    journal: Option<Vec<Change>>,
 }
 
 impl<'a> Flipper<'a> {
-    fn new(cdt: &'a mut Cdt, region: &'a Region, lift: Lifting, crossing: &[TetId]) -> Self {
+    fn new(
+        cdt: &'a mut Cdt,
+        region: &'a Region,
+        lift: Lifting,
+        crossing: &[TetId],
+        journal: bool,
+    ) -> Self {
         let mut marks = Marks::new(cdt.dt.points.len());
         let mut gens = Gens::new(cdt.dt.mesh.num_slots());
         for &t in crossing {
@@ -645,6 +693,8 @@ impl<'a> Flipper<'a> {
             free_covers: Vec::new(),
             cover_head: Vec::new(),
             crossing_left: 0,
+            stuck_near: Vec::new(),
+            journal: journal.then(Vec::new),
         }
     }
 
@@ -713,10 +763,16 @@ impl<'a> Flipper<'a> {
             .all(|t| self.cdt.find_face(t[0], t[1], t[2]).is_some());
         if !ok {
             let r = self.tets_of_r();
-            self.crossing_left = r
+            let left: Vec<TetId> = r
                 .iter()
-                .filter(|&&t| self.is_crossing(&self.cdt.dt.mesh.verts(t)))
-                .count();
+                .copied()
+                .filter(|&t| self.is_crossing(&self.cdt.dt.mesh.verts(t)))
+                .collect();
+            self.crossing_left = left.len();
+            self.stuck_near = left
+                .iter()
+                .flat_map(|&t| self.cdt.dt.mesh.verts(t))
+                .collect();
             if debug() {
                 eprintln!(
                     "stuck: {} tets in R, {} crossing, {} deferred flips",
@@ -1179,6 +1235,13 @@ impl<'a> Flipper<'a> {
     /// Replaces tets `old` by the positively oriented tets `new` (which fill the same
     /// volume), keeping R's membership and noting the subfaces at risk.
     fn replace(&mut self, sh: &bistellar::Shape) -> Result<Few<TetId>, MeshError> {
+        if let Some(journal) = &mut self.journal {
+            let mesh = &self.cdt.dt.mesh;
+            journal.push(Change {
+                old: sh.old.iter().map(|&t| (t, *mesh.tet(t))).collect(),
+                new: Vec::new(),
+            });
+        }
         let subfaces = &self.cdt.subfaces;
         let at_risk = &mut self.at_risk;
         let made = bistellar::flip(&mut self.cdt.dt.mesh, sh, !subfaces.is_empty(), |key| {
@@ -1194,6 +1257,9 @@ impl<'a> Flipper<'a> {
             self.gens.renew(t);
             self.gens.set_in_r(t, true);
             self.r_list.push(t);
+        }
+        if let Some(c) = self.journal.as_mut().and_then(|j| j.last_mut()) {
+            c.new = made.to_vec();
         }
         Ok(made)
     }
@@ -1369,5 +1435,58 @@ mod tests {
             }
             assert!(used.iter().all(|&u| u), "seed {seed}: a vertex was lost");
         }
+    }
+
+    /// The tets of the mesh (ghosts included), as sorted vertex quadruples.
+    fn tet_set(cdt: &Cdt) -> Vec<[VertexId; 4]> {
+        let mesh = &cdt.dt.mesh;
+        let mut v: Vec<[VertexId; 4]> = (0..mesh.num_slots() as TetId)
+            .filter(|&t| mesh.is_alive(t))
+            .map(|t| {
+                let mut k = mesh.verts(t);
+                k.sort_unstable();
+                k
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    }
+
+    /// The flips of a region, recorded, are taken back exactly: the same tets, glued
+    /// as before (what a stuck polygon that is not flat relies on).
+    #[test]
+    fn recorded_flips_are_taken_back_exactly() {
+        let mut s = 12345;
+        let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
+        while pts.len() < 200 {
+            let z = 0.2 * lcg(&mut s) - 0.1;
+            if z != 0.0 {
+                pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
+            }
+        }
+        let dt = Delaunay::build(&pts).unwrap().dt;
+        let inv = dt.internal_ids(pts.len());
+        let mut cdt = Cdt::new(dt);
+        let before = tet_set(&cdt);
+        let tris = [[inv[0], inv[1], inv[2]]];
+        let region = Region::new(&cdt, &tris);
+        let crossing = crossing_tets(&mut cdt, &region).unwrap();
+        let lift = Lifting {
+            abc: largest_triangle(&cdt, &region),
+        };
+        let mut fl = Flipper::new(&mut cdt, &region, lift, &crossing, true);
+        assert!(fl.run().unwrap());
+        let flips = fl.counts.total();
+        let journal = fl.journal.take().unwrap();
+        drop(fl);
+        assert!(
+            flips > 50 && journal.len() == flips,
+            "{flips} flips, {} recorded",
+            journal.len()
+        );
+        assert_ne!(tet_set(&cdt), before);
+        cdt.dt.undo_changes(&journal);
+        cdt.dt.mesh.check_links().unwrap();
+        assert_eq!(tet_set(&cdt), before);
     }
 }

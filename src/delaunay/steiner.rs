@@ -163,6 +163,18 @@ impl Delaunay {
     /// `changes`, oldest first, the insertion's own first), restoring the mesh exactly;
     /// `last` is where point location started before.
     pub fn undo(&mut self, v: VertexId, changes: &[Change], last: TetId) {
+        self.undo_changes(changes);
+        self.created.clear();
+        self.last = last;
+        if self.points.len() == v as usize + 1 {
+            self.points.pop();
+            self.orig.pop();
+        }
+    }
+
+    /// Takes back `changes` (oldest first) and nothing else, restoring the tets exactly
+    /// as they were before the first: the vertices stay.
+    pub fn undo_changes(&mut self, changes: &[Change]) {
         if self.mark.len() < self.mesh.num_slots() {
             self.mark.resize(self.mesh.num_slots(), 0);
         }
@@ -192,12 +204,6 @@ impl Delaunay {
             for &(t, _) in &c.old {
                 self.mark[t as usize] = 0;
             }
-        }
-        self.created.clear();
-        self.last = last;
-        if self.points.len() == v as usize + 1 {
-            self.points.pop();
-            self.orig.pop();
         }
     }
 
