@@ -1379,25 +1379,30 @@ mod tests {
 
     use crate::geom::lcg;
 
+    /// A big triangle in the plane z = 0 (far enough out that its edges are hull edges,
+    /// which the driver would recover) and random points near that plane, as in the
+    /// Figure 9 experiment; the CDT of them all and the triangle's vertex ids.
+    fn triangle_in_points(seed: u64, count: usize) -> (Cdt, [VertexId; 3]) {
+        let mut s = seed;
+        let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
+        while pts.len() < count {
+            let z = 0.2 * lcg(&mut s) - 0.1;
+            if z != 0.0 {
+                pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
+            }
+        }
+        let dt = Delaunay::build(&pts).unwrap().dt;
+        let inv = dt.internal_ids(pts.len());
+        (Cdt::new(dt), [inv[0], inv[1], inv[2]])
+    }
+
     /// Points near the plane z = 0 and a big triangle in it, as the Figure 9 experiment:
     /// inserted by flips, the result is a valid arena, keeps every vertex, has the
     /// triangle as a face, and every other face is locally Delaunay (a CDT).
     #[test]
     fn flips_insert_a_triangle_into_random_points() {
         for seed in 0..6u64 {
-            let mut s = seed * 7919 + 1;
-            // Far enough out that its edges are hull edges (the driver recovers them).
-            let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
-            while pts.len() < 150 {
-                let z = 0.2 * lcg(&mut s) - 0.1;
-                if z != 0.0 {
-                    pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
-                }
-            }
-            let dt = Delaunay::build(&pts).unwrap().dt;
-            let inv = dt.internal_ids(pts.len());
-            let mut cdt = Cdt::new(dt);
-            let tri = [inv[0], inv[1], inv[2]];
+            let (mut cdt, tri) = triangle_in_points(seed * 7919 + 1, 150);
             for k in 0..3 {
                 assert!(cdt.has_edge(tri[k], tri[(k + 1) % 3]));
             }
@@ -1410,7 +1415,7 @@ mod tests {
             assert!(counts.total() > 0 && rs.crossing_tets > 10, "seed {seed}");
             cdt.dt.mesh.check_links().unwrap();
             assert!(cdt.find_face(tri[0], tri[1], tri[2]).is_some());
-            let mut used = vec![false; pts.len()];
+            let mut used = vec![false; cdt.dt.points.len()];
             let key = face_key(tri);
             for t in cdt.dt.mesh.real_tets().collect::<Vec<_>>() {
                 let v = cdt.dt.mesh.verts(t);
@@ -1456,19 +1461,9 @@ mod tests {
     /// as before (what a stuck polygon that is not flat relies on).
     #[test]
     fn recorded_flips_are_taken_back_exactly() {
-        let mut s = 12345;
-        let mut pts: Vec<Point> = vec![[-4.0, -4.0, 0.0], [5.0, -3.0, 0.0], [0.0, 5.0, 0.0]];
-        while pts.len() < 200 {
-            let z = 0.2 * lcg(&mut s) - 0.1;
-            if z != 0.0 {
-                pts.push([2.0 * lcg(&mut s) - 1.0, 2.0 * lcg(&mut s) - 1.0, z]);
-            }
-        }
-        let dt = Delaunay::build(&pts).unwrap().dt;
-        let inv = dt.internal_ids(pts.len());
-        let mut cdt = Cdt::new(dt);
+        let (mut cdt, tri) = triangle_in_points(12345, 200);
         let before = tet_set(&cdt);
-        let tris = [[inv[0], inv[1], inv[2]]];
+        let tris = [tri];
         let region = Region::new(&cdt, &tris);
         let crossing = crossing_tets(&mut cdt, &region).unwrap();
         let lift = Lifting {
