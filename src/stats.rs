@@ -128,10 +128,6 @@ impl Stats {
                 ),
                 ("    fallbacks to cavity retriangulation", fallbacks),
                 (
-                    "    hand-overs for polygons not flat",
-                    f.not_flat_handovers.to_string(),
-                ),
-                (
                     "    stuck on polygons not flat: Steiner points",
                     f.not_flat_stuck.to_string(),
                 ),
@@ -203,7 +199,7 @@ impl Stats {
             ];
             fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
             let f = &p.flips;
-            let flips: [(&str, usize); 13] = [
+            let flips: [(&str, usize); 12] = [
                 ("flips", f.total()),
                 ("flips_2_3", f.flips23),
                 ("flips_3_2", f.flips32),
@@ -215,7 +211,6 @@ impl Stats {
                 ("flips_refused_by_constraints", f.constrained),
                 ("exact_flip_time_compares", f.exact_compares),
                 ("flip_fallbacks", f.fallbacks),
-                ("flip_not_flat_handovers", f.not_flat_handovers),
                 ("flip_not_flat_stuck", f.not_flat_stuck),
             ];
             fields.extend(

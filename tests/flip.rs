@@ -4,7 +4,9 @@
 //!   and never falls back to the cavity algorithm, and, where neither algorithm adds
 //!   Steiner points, has exactly `-C`'s tets.
 //! - Polygons far from flat (the 40-gon prisms whose caps are 1e-5 off their plane) get
-//!   the flips stuck; they are taken back and a Steiner point goes on the polygon.
+//!   the flips stuck; they are taken back and a Steiner point goes on the polygon. So do
+//!   flips that triangulate a polygon otherwise than its region
+//!   (`data/flip/bent_9gon_60.poly`, from `scripts/gen-bent-polygon.py`).
 //! - The paper's stuck configuration (`data/flip/prism_stuck.poly`: cospherical prism
 //!   corners and a vertex inside their sphere) is inserted by flips alone, through
 //!   perturbed ties, with `-C`'s tets.
@@ -105,6 +107,20 @@ fn flips_stuck_on_polygons_not_flat_are_taken_back_for_a_steiner_point() {
         let p = f.stats.plc.as_ref().unwrap();
         assert!(p.facet_steiner_points > 0, "{name}: no point on a polygon");
     }
+}
+
+/// A 9-gon 1e-9 off its plane among 60 points near it: the flips triangulate the
+/// polygon otherwise than the region, with no crossing tet left, and faces that are not
+/// locally Delaunay once the weights are restored. They used to go to the cavity code as
+/// they were, and the mesh was no CDT; now they are taken back for a Steiner point.
+#[test]
+fn a_polygon_triangulated_otherwise_by_the_flips_gets_a_steiner_point() {
+    let path = root().join("data/flip/bent_9gon_60.poly");
+    let f = mesh(&path, "-pcQF");
+    let counts = flips(&f);
+    assert!(counts.not_flat_stuck > 0, "{counts:?}");
+    assert_eq!(counts.fallbacks, 0, "{counts:?}");
+    assert!(steiner(&f) > 0);
 }
 
 #[test]
@@ -217,8 +233,9 @@ fn flip_meshes_pass_the_referee() {
     let dir = tempfile::tempdir().unwrap();
     let mut models = plc_models();
     models.push(root().join("data/flip/prism_stuck.poly"));
+    models.push(root().join("data/flip/bent_9gon_60.poly"));
     for path in models {
-        let hull = path.ends_with("prism_stuck.poly");
+        let hull = path.starts_with(root().join("data/flip"));
         let prefix = dir.path().join("out");
         let sw = if hull { "-pcQF" } else { "-pQF" };
         let st = std::process::Command::new(env!("CARGO_BIN_EXE_tetcdt"))

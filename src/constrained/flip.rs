@@ -53,13 +53,10 @@ pub struct FlipCounts {
     pub constrained: usize,
     /// Regions that fell back to cavity retriangulation.
     pub fallbacks: usize,
-    /// Regions of polygons that are not flat, left without crossing simplices but not
-    /// recovered (near-shims, another triangulation of the polygon): handed to the
-    /// cavity code, which adopts the triangulation or places a Steiner point.
-    pub not_flat_handovers: usize,
-    /// Regions of polygons that are not flat whose flips got stuck with crossing tets
-    /// left: the flips were taken back and the region asked for a Steiner point on the
-    /// polygon, as the paper does for the other troubles of such polygons.
+    /// Regions of polygons that are not flat whose flips got stuck (crossing tets left,
+    /// or the polygon triangulated otherwise than the region): the flips were taken back
+    /// and the region asked for a Steiner point on the polygon, as the paper does for
+    /// the other troubles of such polygons.
     pub not_flat_stuck: usize,
     /// Flip-time comparisons that needed exact arithmetic.
     pub exact_compares: usize,
@@ -79,7 +76,6 @@ impl FlipCounts {
         self.deferred += o.deferred;
         self.constrained += o.constrained;
         self.fallbacks += o.fallbacks;
-        self.not_flat_handovers += o.not_flat_handovers;
         self.not_flat_stuck += o.not_flat_stuck;
         self.exact_compares += o.exact_compares;
         self.perturbed_compares += o.perturbed_compares;
@@ -297,7 +293,6 @@ pub fn insert_region(
         .set(fl.cdt.work.get() + EXACT_WORK_UNITS * exact_work);
     counts.add(&here);
     let mut at_risk = std::mem::take(&mut fl.at_risk);
-    let crossing_left = fl.crossing_left;
     let stuck_near = std::mem::take(&mut fl.stuck_near);
     let journal = fl.journal.take();
     drop(fl);
@@ -311,11 +306,14 @@ pub fn insert_region(
     }
     match problem {
         None => {}
-        Some(Problem::Stuck) if !flat && crossing_left > 0 => {
+        Some(Problem::Stuck) if !flat => {
             // The weights order the flips as if the polygon's vertices lay on the lifting
-            // plane; off it, the flips can get stuck. The mesh goes back to the CDT it was
-            // and the polygon gets a point near the crossing tets left, where the cavity
-            // code would put it for a shim, so the next try has smaller, flatter pieces.
+            // plane; off it, the flips can get stuck, with crossing tets left or with the
+            // polygon triangulated otherwise than the region (whose faces then need not
+            // be locally Delaunay once the weights are restored). The mesh goes back to
+            // the CDT it was and the polygon gets a point near the trouble, where the
+            // cavity code would put it for a shim, so the next try has smaller, flatter
+            // pieces.
             if let Some(changes) = journal {
                 cdt.dt.undo_changes(&changes);
             }
@@ -349,19 +347,10 @@ pub fn insert_region(
             )));
         }
         Some(p) => {
-            // A polygon that is not flat, with no crossing simplex left, can still be
-            // crossed by tets whose vertices all lie on one side of the plane or on the
-            // polygon (near-shims), or be triangulated differently from its 2D CDT. The
-            // cavity code then adopts the mesh's triangulation or places a Steiner point:
-            // a hand-over for polygons that are not flat, not a failure of the flips.
-            let not_flat = matches!(p, Problem::Stuck) && !flat && crossing_left == 0;
-            if not_flat {
-                counts.not_flat_handovers += 1;
-            } else {
-                counts.fallbacks += 1;
-            }
+            // A flat polygon: with exact flip times this should not happen.
+            counts.fallbacks += 1;
             if debug() {
-                eprintln!("facet {facet}: flips hand over to the cavity code ({p:?}, not flat {not_flat})");
+                eprintln!("facet {facet}: flips fall back to the cavity code ({p:?})");
             }
             let mut lost = lost_subfaces(cdt, &mut at_risk);
             return Ok(match cavity::insert_region(cdt, tris, facet, normal)? {
@@ -645,9 +634,8 @@ struct Flipper<'a> {
     free_covers: Vec<u32>,
     /// The first cover of each event ([`NO_COVER`]: none).
     cover_head: Vec<u32>,
-    /// Crossing tets (a left and a right vertex) left when the queue ran dry.
-    crossing_left: usize,
-    /// The vertices of those tets.
+    /// Where the flips got stuck: the vertices of the crossing tets (a left and a right
+    /// vertex) left when the queue ran dry, or else of the region's missing triangles.
     stuck_near: Vec<VertexId>,
     /// Every flip made, oldest first, when they may have to be taken back.
     journal: Option<Vec<Change>>,
@@ -692,7 +680,6 @@ impl<'a> Flipper<'a> {
             covers: Vec::new(),
             free_covers: Vec::new(),
             cover_head: Vec::new(),
-            crossing_left: 0,
             stuck_near: Vec::new(),
             journal: journal.then(Vec::new),
         }
@@ -768,16 +755,25 @@ impl<'a> Flipper<'a> {
                 .copied()
                 .filter(|&t| self.is_crossing(&self.cdt.dt.mesh.verts(t)))
                 .collect();
-            self.crossing_left = left.len();
+            // Near the crossing tets left, or else near the region's triangles that are
+            // not faces (the flips triangulated the polygon otherwise).
             self.stuck_near = left
                 .iter()
                 .flat_map(|&t| self.cdt.dt.mesh.verts(t))
                 .collect();
+            if self.stuck_near.is_empty() {
+                self.stuck_near = tris
+                    .iter()
+                    .filter(|t| self.cdt.find_face(t[0], t[1], t[2]).is_none())
+                    .flatten()
+                    .copied()
+                    .collect();
+            }
             if debug() {
                 eprintln!(
                     "stuck: {} tets in R, {} crossing, {} deferred flips",
                     r.len(),
-                    self.crossing_left,
+                    left.len(),
                     self.deferred.len()
                 );
             }
