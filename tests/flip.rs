@@ -6,7 +6,9 @@
 //! - Polygons far from flat (the 40-gon prisms whose caps are 1e-5 off their plane) get
 //!   the flips stuck; they are taken back and a Steiner point goes on the polygon. So do
 //!   flips that triangulate a polygon otherwise than its region
-//!   (`data/flip/bent_9gon_60.poly`, from `scripts/gen-bent-polygon.py`).
+//!   (`data/flip/bent_9gon_60.poly`, from `scripts/gen-bent-polygon.py`). After two
+//!   such points on one facet, its stuck regions fall back to cavities, counted
+//!   (`data/flip/bent_17gon_150.poly`).
 //! - The paper's stuck configuration (`data/flip/prism_stuck.poly`: cospherical prism
 //!   corners and a vertex inside their sphere) is inserted by flips alone, through
 //!   perturbed ties, with `-C`'s tets.
@@ -123,6 +125,17 @@ fn a_polygon_triangulated_otherwise_by_the_flips_gets_a_steiner_point() {
     assert!(steiner(&f) > 0);
 }
 
+/// A 17-gon 1e-3 off its plane among 150 points: its flips get stuck again after two
+/// Steiner points, and its stuck regions then fall back to cavities, counted.
+#[test]
+fn a_polygon_whose_flips_stay_stuck_falls_back_after_two_points() {
+    let path = root().join("data/flip/bent_17gon_150.poly");
+    let f = mesh(&path, "-pcQF");
+    let counts = flips(&f);
+    assert_eq!(counts.not_flat_stuck, 2, "{counts:?}");
+    assert!(counts.fallbacks > 0, "{counts:?}");
+}
+
 #[test]
 fn stuck_prism_is_inserted_by_flips_alone() {
     let path = root().join("data/flip/prism_stuck.poly");
@@ -234,6 +247,7 @@ fn flip_meshes_pass_the_referee() {
     let mut models = plc_models();
     models.push(root().join("data/flip/prism_stuck.poly"));
     models.push(root().join("data/flip/bent_9gon_60.poly"));
+    models.push(root().join("data/flip/bent_17gon_150.poly"));
     for path in models {
         let hull = path.starts_with(root().join("data/flip"));
         let prefix = dir.path().join("out");

@@ -44,6 +44,9 @@ pub struct Cdt {
     /// ([`crate::error::MeshError::WorkBound`]): a single region can cost more than all
     /// restarts may, around a vertex far out of scale.
     pub work_limit: u64,
+    /// Per facet, how often its flips got stuck on a polygon that is not flat and asked
+    /// for a Steiner point in this construction (see [`super::flip::insert_region`]).
+    pub flips_stuck: FxHashMap<u32, u32>,
 }
 
 impl Cdt {
@@ -57,6 +60,7 @@ impl Cdt {
             scratch: Vec::new(),
             work: std::cell::Cell::new(0),
             work_limit: u64::MAX,
+            flips_stuck: FxHashMap::default(),
         }
     }
 

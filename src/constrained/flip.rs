@@ -244,6 +244,12 @@ fn put<T>(slots: &mut Vec<T>, free: &mut Vec<u32>, x: T) -> u32 {
     }
 }
 
+/// Steiner points a facet may get in one construction for flips stuck on its polygon
+/// that is not flat; past them its stuck regions fall back to cavity retriangulation:
+/// each point costs the region's flips again, and where a few do not settle them (a
+/// polygon 1e-3 of its size off flat among points near it) more seldom do.
+const MAX_STUCK_POINTS: u32 = 2;
+
 /// Work units ([`Cdt::work`]) per unit of [`CompareCounts::exact_work`]: a product of
 /// components costs about 64 ns, a crossing test about 35 ns (both measured with perf).
 const EXACT_WORK_UNITS: u64 = 2;
@@ -306,6 +312,20 @@ pub fn insert_region(
     }
     match problem {
         None => {}
+        Some(Problem::Stuck)
+            if !flat && cdt.flips_stuck.get(&facet).copied().unwrap_or(0) >= MAX_STUCK_POINTS =>
+        {
+            // Steiner points did not settle this polygon's flips: the cavity code
+            // inserts the region into the CDT as it was, a counted fallback.
+            if let Some(changes) = journal {
+                cdt.dt.undo_changes(&changes);
+            }
+            counts.fallbacks += 1;
+            if debug() {
+                eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, cavities");
+            }
+            return cavity::insert_region(cdt, tris, facet, normal);
+        }
         Some(Problem::Stuck) if !flat => {
             // The weights order the flips as if the polygon's vertices lay on the lifting
             // plane; off it, the flips can get stuck, with crossing tets left or with the
@@ -318,6 +338,7 @@ pub fn insert_region(
                 cdt.dt.undo_changes(&changes);
             }
             counts.not_flat_stuck += 1;
+            *cdt.flips_stuck.entry(facet).or_insert(0) += 1;
             let near = tris
                 .iter()
                 .max_by_key(|t| t.iter().filter(|x| stuck_near.contains(x)).count())
