@@ -15,7 +15,7 @@
 //! dry, the region falls back to cavity retriangulation, which is counted and reported;
 //! but a polygon that is not flat, whose vertices off the lifting plane break the order
 //! the flips rely on, gets a Steiner point instead, the flips taken back first (up to
-//! [`MAX_STUCK_POINTS`] per facet and construction; then it falls back too).
+//! two per facet and construction, `MAX_STUCK_POINTS`; then it falls back too).
 //!
 //! After the region is in, the weights are restored: faces in R that are not locally
 //! Delaunay (polygons that are not exactly flat) are repaired by flips where possible,
