@@ -465,7 +465,7 @@ fn read_ascii(
     header: &Header,
     model: &mut Model<'_>,
 ) -> Result<(), InputError> {
-    for e in &header.elements {
+    for e in header.elements.iter().filter(|e| !e.props.is_empty()) {
         let roles = Model::roles(e);
         let is_vertex = e.name == "vertex";
         let is_face = e.name == "face";
@@ -572,7 +572,7 @@ fn read_binary(
         msg,
     };
     let mut pos = 0usize;
-    for e in &header.elements {
+    for e in header.elements.iter().filter(|e| !e.props.is_empty()) {
         let roles = Model::roles(e);
         // A lying count cannot make us allocate: each record takes at least min_size bytes.
         let min = e.min_size();
@@ -724,6 +724,23 @@ mod tests {
         assert_eq!(plc.facets[1].polygons, vec![vec![0, 1, 2, 3]]);
         assert_eq!(plc.facets[1].line, 22);
         assert_eq!(plc.first_index, 0);
+    }
+
+    #[test]
+    fn elements_without_properties_take_no_time_whatever_their_count() {
+        // Their records hold nothing, so a huge count must not be counted through.
+        let huge = "element edge 18446744073709551615\nelement face 2\n";
+        let text = format!(
+            "{HEAD}0 1 0 0\n1 2 0 0\n0 3 1 0\n0 4 0 1\n3 0 1 2 0.5\n3 0 1 2 9\n4 0 1 2 3 1e3\n"
+        )
+        .replacen("element face 2\n", huge, 1);
+        assert_eq!(parse(text.as_bytes(), p()).unwrap().facets.len(), 2);
+        let b = binary_file(false, 1.0, 2.0);
+        let at = b.windows(10).position(|w| w == b"end_header").unwrap();
+        let mut with_empty = b[..at].to_vec();
+        with_empty.extend_from_slice(b"element nothing 18446744073709551615\n");
+        with_empty.extend_from_slice(&b[at..]);
+        assert_eq!(parse(&with_empty, p()).unwrap().facets.len(), 2);
     }
 
     /// Encodes values of the given types in one byte order.
