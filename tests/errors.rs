@@ -219,6 +219,19 @@ fn fuzz_regression_twisted_quads_are_refused() {
     assert!(stderr.contains("is not flat"), "{stderr}");
 }
 
+/// Found by `tests/fuzz.rs`: `cube.ply` with an element of no properties announced
+/// 24,294,967,296 times; the reader counted through its empty records for minutes.
+#[test]
+fn fuzz_regression_empty_ply_elements_are_not_counted_through() {
+    let (code, stderr) = mutated(
+        "formats/cube.ply",
+        "element edge 2\n",
+        "element edge 24294967296\nelement edge 2\n",
+        &["-pQ", "--check"],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+}
+
 /// Found by `tests/fuzz.rs`: `star.off` with one vertex moved 4.3e9 units away needs
 /// free points, and one was located in a hull tet, whose ghost vertex the orientation
 /// check of its walled cavity read.
