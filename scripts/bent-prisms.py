@@ -2,7 +2,7 @@
 """Meshes random prisms whose polygons are not flat, and sums up what happened.
 
 usage: scripts/bent-prisms.py [--count N] [--dev D,...] [--seed S] [--switches SW,...]
-                              [--keep DIR] [--no-validate]
+                              [--keep DIR] [--no-validate] [--polygons]
 
 Each prism has an n-gon (n from 6 to 80) for its bottom and top, of random size and
 place; every cap vertex is moved off its plane, and every top vertex radially, by up to
@@ -11,8 +11,13 @@ points inside are added as isolated vertices. For each prism and each switch set
 (default -pQ,-pQF) it runs `tetcdt SW --stats-json`, then the shared validator where
 numpy is found (../shared/tools/validate_mesh.py, or $TETCDT_TOOLS). Prints, per
 deviation and switch set: failed runs (exit code not 0), regions that fell back from
-flips to cavities, regions stuck on polygons not flat (flips taken back), meshes the
-validator rejects, and the slowest run. --keep DIR keeps the inputs of rejected meshes.
+flips to cavities, regions stuck on polygons not flat (flips taken back; of these, how
+many got the point the cavity code placed), meshes the validator rejects, and the
+slowest run. --keep DIR keeps the inputs of rejected meshes.
+
+--polygons meshes, instead of prisms, one K-gon (K from 3 to 32) off its plane by up to
+D among N random points near it (N from 50 to 2,000), written by
+scripts/gen-bent-polygon.py (default switches -pcQ,-pcQF).
 Environment: TETCDT (the binary, default target/release/tetcdt).
 """
 import json
@@ -74,6 +79,7 @@ def main(argv):
     opts = {"--count": "100", "--dev": "1e-5,1e-4,1e-3", "--seed": "1",
             "--switches": "-pQ,-pQF", "--keep": ""}
     validate = True
+    polygons = False
     args = list(argv[1:])
     while args:
         a = args.pop(0)
@@ -82,6 +88,10 @@ def main(argv):
             return 0
         if a == "--no-validate":
             validate = False
+        elif a == "--polygons":
+            polygons = True
+            if opts["--switches"] == "-pQ,-pQF":
+                opts["--switches"] = "-pcQ,-pcQF"
         elif a in opts and args:
             opts[a] = args.pop(0)
         else:
@@ -99,12 +109,19 @@ def main(argv):
     with tempfile.TemporaryDirectory() as work:
         for dev in map(float, opts["--dev"].split(",")):
             rng = random.Random(f"{opts['--seed']}/{dev}")
-            tally = {sw: dict(failed=0, fallbacks=0, stuck=0, rejected=0, slowest=0.0)
+            tally = {sw: dict(failed=0, fallbacks=0, stuck=0, cavity_points=0, rejected=0,
+                              slowest=0.0)
                      for sw in switches}
             for case in range(int(opts["--count"])):
                 inp = os.path.join(work, "prism.poly")
                 n, extra = rng.randint(6, 80), rng.randint(0, 39)
-                write_prism(inp, n, dev, rng, extra)
+                if polygons:
+                    gen = os.path.join(ROOT, "scripts", "gen-bent-polygon.py")
+                    n, extra = rng.randint(3, 32), rng.randint(50, 2000)
+                    subprocess.run([sys.executable, gen, str(extra), inp,
+                                    str(rng.randrange(1 << 30)), repr(dev), str(n)], check=True)
+                else:
+                    write_prism(inp, n, dev, rng, extra)
                 for sw in switches:
                     t = tally[sw]
                     out, stats = os.path.join(work, "out"), os.path.join(work, "s.json")
@@ -118,22 +135,26 @@ def main(argv):
                     js = json.load(open(stats))
                     t["fallbacks"] += int(js.get("flip_fallbacks", 0))
                     t["stuck"] += int(js.get("flip_not_flat_stuck", 0))
+                    t["cavity_points"] += int(js.get("flip_not_flat_cavity_points", 0))
                     if not check:
                         continue
-                    v = subprocess.run([sys.executable, check, inp, out],
+                    hull = ["--hull"] if polygons else []
+                    v = subprocess.run([sys.executable, check, inp, out] + hull,
                                        capture_output=True, text=True)
                     if v.returncode != 0:
                         t["rejected"] += 1
                         last = (v.stdout.strip().splitlines() or ["?"])[-1]
-                        print(f"dev {dev:g} case {case} (n={n}, {extra} inside) {sw}: {last}")
+                        print(f"dev {dev:g} case {case} (n={n}, {extra} more) {sw}: {last}")
                         if opts["--keep"]:
                             os.makedirs(opts["--keep"], exist_ok=True)
                             name = f"prism_{dev:g}_{case}.poly"
                             with open(inp) as src, open(os.path.join(opts["--keep"], name), "w") as dst:
                                 dst.write(src.read())
             for sw, t in tally.items():
-                print(f"dev {dev:g} {sw}: {opts['--count']} prisms, failed {t['failed']}, "
-                      f"fallbacks {t['fallbacks']}, stuck {t['stuck']}, "
+                what = "polygons" if polygons else "prisms"
+                print(f"dev {dev:g} {sw}: {opts['--count']} {what}, failed {t['failed']}, "
+                      f"fallbacks {t['fallbacks']}, stuck {t['stuck']} "
+                      f"({t['cavity_points']} points by the cavity code), "
                       f"rejected {t['rejected'] if check else 'n.a.'}, slowest {t['slowest']:.2f} s")
     return 0
 

@@ -131,6 +131,10 @@ impl Stats {
                     "    stuck on polygons not flat: Steiner points",
                     f.not_flat_stuck.to_string(),
                 ),
+                (
+                    "      of which placed by the cavity code",
+                    f.not_flat_cavity_points.to_string(),
+                ),
             ]);
         }
         rows.extend([
@@ -199,7 +203,7 @@ impl Stats {
             ];
             fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
             let f = &p.flips;
-            let flips: [(&str, usize); 12] = [
+            let flips: [(&str, usize); 13] = [
                 ("flips", f.total()),
                 ("flips_2_3", f.flips23),
                 ("flips_3_2", f.flips32),
@@ -212,6 +216,7 @@ impl Stats {
                 ("exact_flip_time_compares", f.exact_compares),
                 ("flip_fallbacks", f.fallbacks),
                 ("flip_not_flat_stuck", f.not_flat_stuck),
+                ("flip_not_flat_cavity_points", f.not_flat_cavity_points),
             ];
             fields.extend(
                 flips

@@ -59,6 +59,10 @@ pub struct FlipCounts {
     /// and the region asked for a Steiner point on the polygon, as the paper does for
     /// the other troubles of such polygons.
     pub not_flat_stuck: usize,
+    /// Of those, regions stuck after their facet's last own point
+    /// ([`MAX_STUCK_POINTS`]) whose point the cavity code placed: asked to insert the
+    /// region on the CDT as it was, it found that the region needs a point there too.
+    pub not_flat_cavity_points: usize,
     /// Flip-time comparisons that needed exact arithmetic.
     pub exact_compares: usize,
     /// Of those, exact ties broken by the symbolic perturbation.
@@ -78,6 +82,7 @@ impl FlipCounts {
         self.constrained += o.constrained;
         self.fallbacks += o.fallbacks;
         self.not_flat_stuck += o.not_flat_stuck;
+        self.not_flat_cavity_points += o.not_flat_cavity_points;
         self.exact_compares += o.exact_compares;
         self.perturbed_compares += o.perturbed_compares;
     }
@@ -316,16 +321,30 @@ pub fn insert_region(
         Some(Problem::Stuck)
             if !flat && cdt.flips_stuck.get(&facet).copied().unwrap_or(0) >= MAX_STUCK_POINTS =>
         {
-            // Steiner points did not settle this polygon's flips: the cavity code
-            // inserts the region into the CDT as it was, a counted fallback.
+            // Steiner points did not settle this polygon's flips: the region goes to
+            // the cavity code on the CDT as it was. Where that inserts it, it is a
+            // counted fallback; where it finds that the region needs a point (it
+            // decides so before changing the mesh), the region is no more insertable
+            // by cavities than by flips, and gets that point: the Steiner point code
+            // the two algorithms share.
             if let Some(changes) = journal {
                 cdt.dt.undo_changes(&changes);
             }
-            counts.fallbacks += 1;
-            if debug() {
-                eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, cavities");
+            let outcome = cavity::insert_region(cdt, tris, facet, normal)?;
+            if matches!(outcome, Outcome::Inserted(_)) {
+                counts.fallbacks += 1;
+            } else {
+                counts.not_flat_stuck += 1;
+                counts.not_flat_cavity_points += 1;
             }
-            return cavity::insert_region(cdt, tris, facet, normal);
+            if debug() {
+                let how = match outcome {
+                    Outcome::Inserted(_) => "inserted by cavities",
+                    _ => "the cavity code asks for a point",
+                };
+                eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, {how}");
+            }
+            return Ok(outcome);
         }
         Some(Problem::Stuck) if !flat => {
             // The weights order the flips as if the polygon's vertices lay on the lifting
