@@ -12,8 +12,8 @@ points inside are added as isolated vertices. For each prism and each switch set
 numpy is found (../shared/tools/validate_mesh.py, or $TETCDT_TOOLS). Prints, per
 deviation and switch set: failed runs (exit code not 0), regions that fell back from
 flips to cavities, regions stuck on polygons not flat (flips taken back; of these, how
-many got the point the cavity code placed), meshes the validator rejects, and the
-slowest run. --keep DIR keeps the inputs of rejected meshes.
+many got the point the cavity code placed), the Steiner points in all, meshes the
+validator rejects, and the slowest run. --keep DIR keeps the inputs of rejected meshes.
 
 --polygons meshes, instead of prisms, one K-gon (K from 3 to 32) off its plane by up to
 D among N random points near it (N from 50 to 2,000), written by
@@ -109,8 +109,8 @@ def main(argv):
     with tempfile.TemporaryDirectory() as work:
         for dev in map(float, opts["--dev"].split(",")):
             rng = random.Random(f"{opts['--seed']}/{dev}")
-            tally = {sw: dict(failed=0, fallbacks=0, stuck=0, cavity_points=0, rejected=0,
-                              slowest=0.0)
+            tally = {sw: dict(failed=0, fallbacks=0, stuck=0, cavity_points=0, points=0,
+                              rejected=0, slowest=0.0)
                      for sw in switches}
             for case in range(int(opts["--count"])):
                 inp = os.path.join(work, "prism.poly")
@@ -136,6 +136,7 @@ def main(argv):
                     t["fallbacks"] += int(js.get("flip_fallbacks", 0))
                     t["stuck"] += int(js.get("flip_not_flat_stuck", 0))
                     t["cavity_points"] += int(js.get("flip_not_flat_cavity_points", 0))
+                    t["points"] += int(js.get("steiner_points", 0))
                     if not check:
                         continue
                     hull = ["--hull"] if polygons else []
@@ -155,6 +156,7 @@ def main(argv):
                 print(f"dev {dev:g} {sw}: {opts['--count']} {what}, failed {t['failed']}, "
                       f"fallbacks {t['fallbacks']}, stuck {t['stuck']} "
                       f"({t['cavity_points']} points by the cavity code), "
+                      f"Steiner points {t['points']}, "
                       f"rejected {t['rejected'] if check else 'n.a.'}, slowest {t['slowest']:.2f} s")
     return 0
 
