@@ -772,6 +772,38 @@ fn json_number(json: &str, key: &str) -> f64 {
     rest[..end].parse().unwrap()
 }
 
+/// `-F`'s stuck regions and fallbacks reach `-V` and `--stats-json`: the 19-gon of
+/// `tests/flip.rs` (4 stuck regions, 2 of them given the cavity code's point, 1 fallback).
+#[test]
+fn flip_fallbacks_and_stuck_regions_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/flip/bent_19gon_60.poly");
+    fs::copy(&src, dir.path().join("p.poly")).unwrap();
+    let (code, stdout, stderr) = run_in(dir.path(), &["-pcFV", "--stats-json", "s.json", "p.poly"]);
+    assert_eq!(code, 0, "{stderr}");
+    let json = fs::read_to_string(dir.path().join("s.json")).unwrap();
+    assert_eq!(json_number(&json, "flip_fallbacks"), 1.0, "{json}");
+    assert_eq!(json_number(&json, "flip_not_flat_stuck"), 4.0, "{json}");
+    assert_eq!(
+        json_number(&json, "flip_not_flat_cavity_points"),
+        2.0,
+        "{json}"
+    );
+    let text = format!("{stdout}{stderr}");
+    for (row, value) in [
+        ("fallbacks to cavity retriangulation", "1"),
+        ("stuck on polygons not flat: Steiner points", "4"),
+        ("of which placed by the cavity code", "2"),
+    ] {
+        let line = text
+            .lines()
+            .find(|l| l.contains(row))
+            .unwrap_or_else(|| panic!("no row {row:?} in {text}"));
+        let after = &line[line.find(row).unwrap() + row.len()..];
+        assert_eq!(after.split_whitespace().next(), Some(value), "{line}");
+    }
+}
+
 #[test]
 fn the_facets_triangulation_is_timed_apart_from_facet_recovery_as_tetgen_times_it() {
     // TetGen reports "Surface mesh seconds" apart from "Facet recovery seconds"; Figure 9
