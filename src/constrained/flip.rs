@@ -60,7 +60,7 @@ pub struct FlipCounts {
     /// the other troubles of such polygons.
     pub not_flat_stuck: usize,
     /// Of those, regions stuck after their facet's last own point
-    /// ([`MAX_STUCK_POINTS`]) whose point the cavity code placed: asked to insert the
+    /// (`MAX_STUCK_POINTS`) whose point the cavity code placed: asked to insert the
     /// region on the CDT as it was, it found that the region needs a point there too.
     pub not_flat_cavity_points: usize,
     /// Flip-time comparisons that needed exact arithmetic.
