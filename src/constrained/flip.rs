@@ -316,6 +316,13 @@ pub fn insert_region(
             here.exact_compares
         );
     }
+    // A polygon that is not flat (the only one whose flips are recorded) with any
+    // problem gets a Steiner point or the cavity code, on the CDT as it was: its flips
+    // are taken back first, so that no face is left that is not locally Delaunay and no
+    // subface of another facet is lost.
+    if let (Some(_), Some(changes)) = (&problem, &journal) {
+        cdt.dt.undo_changes(changes);
+    }
     match problem {
         None => {}
         Some(Problem::Stuck)
@@ -327,9 +334,6 @@ pub fn insert_region(
             // decides so before changing the mesh), the region is no more insertable
             // by cavities than by flips, and gets that point: the Steiner point code
             // the two algorithms share.
-            if let Some(changes) = journal {
-                cdt.dt.undo_changes(&changes);
-            }
             let outcome = cavity::insert_region(cdt, tris, facet, normal)?;
             if matches!(outcome, Outcome::Inserted(_)) {
                 counts.fallbacks += 1;
@@ -354,16 +358,9 @@ pub fn insert_region(
             // the CDT it was and the polygon gets a point near the trouble, where the
             // cavity code would put it for a shim, so the next try has smaller, flatter
             // pieces.
-            if let Some(changes) = journal {
-                cdt.dt.undo_changes(&changes);
-            }
             counts.not_flat_stuck += 1;
             *cdt.flips_stuck.entry(facet).or_insert(0) += 1;
-            let near = tris
-                .iter()
-                .max_by_key(|t| t.iter().filter(|x| stuck_near.contains(x)).count())
-                .copied()
-                .unwrap_or(tris[0]);
+            let near = nearest_triangle(tris, &stuck_near).unwrap_or(tris[0]);
             if debug() {
                 eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, Steiner point near {near:?}");
             }
@@ -372,17 +369,8 @@ pub fn insert_region(
             )));
         }
         Some(Problem::Shim(f)) | Some(Problem::NotDelaunay(f)) if !flat => {
-            // The point goes on the polygon, at the region triangle nearest the trouble,
-            // into the CDT as it was: the flips are taken back, so that no face is left
-            // that is not locally Delaunay, and no subface of another facet is lost.
-            if let Some(changes) = journal {
-                cdt.dt.undo_changes(&changes);
-            }
-            let near = tris
-                .iter()
-                .max_by_key(|t| t.iter().filter(|x| f.contains(x)).count())
-                .copied()
-                .unwrap_or(f);
+            // The point goes on the polygon, at the region triangle nearest the trouble.
+            let near = nearest_triangle(tris, &f).unwrap_or(f);
             return Ok(Outcome::NeedsSteiner(steiner_point(
                 cdt, tris, near, normal,
             )));
@@ -415,6 +403,13 @@ pub fn insert_region(
         enlarged_tets: 0,
         subfaces: tris.len(),
     }))
+}
+
+/// The triangle of `tris` with the most vertices among `near` (the last of the most).
+fn nearest_triangle(tris: &[[VertexId; 3]], near: &[VertexId]) -> Option<[VertexId; 3]> {
+    tris.iter()
+        .max_by_key(|t| t.iter().filter(|x| near.contains(x)).count())
+        .copied()
 }
 
 /// Whether to trace fallbacks on stderr (`TETCDT_DEBUG=1`).
