@@ -143,6 +143,12 @@ impl<T: Interval> FlipQueue<T> {
         bucket_floor(self.full.trailing_zeros() as usize, self.last)
     }
 
+    /// The entry at the front of the binary heap: likely, not surely, the next popped.
+    #[inline]
+    pub(super) fn peek(&self) -> Option<&T> {
+        self.front.first()
+    }
+
     /// Removes and returns the earliest entry (of those kept).
     pub(super) fn pop(&mut self, ord: &mut impl Order<T>) -> Option<T> {
         loop {
