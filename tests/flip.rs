@@ -14,7 +14,8 @@
 //!   corners and a vertex inside their sphere) is inserted by flips alone, through
 //!   perturbed ties, with `-C`'s tets.
 //! - The Figure 9 experiment (`data/flip/fig9_300.poly`, from `gen_fig9.py`): `-F` gives
-//!   TetGen's tets (`data/flip/ref/`, from `tetgen -pcO0`) by flips alone.
+//!   TetGen's tets (`data/flip/ref/`, from `tetgen -pcO0`) by flips alone. With 3,000
+//!   points, whose cavity `-C` triangulates on two threads, `-C` gives `-F`'s tets.
 //! - Where the shared referee `validate_mesh.py` and numpy are found, `-F`'s meshes of
 //!   `data/plc/` pass it too (otherwise that part says it is skipped).
 
@@ -233,6 +234,49 @@ fn figure_9_rectangle_by_cavities_equals_flips() {
     let path = root().join("data/flip/fig9_300.poly");
     let f = mesh(&path, "-pcQF");
     let c = mesh(&path, "-pcQC");
+    assert_eq!(tets(&c), tets(&f));
+}
+
+/// A Figure 9 input of `n` random points (as `gen_fig9.py` makes them, with a seeded
+/// generator of our own), written to a temporary `.poly`.
+fn figure_9_input(n: usize, seed: u64) -> tempfile::TempPath {
+    let mut s = seed;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut text = format!("{} 3 0 0\n1 -2 -2 0\n2 2 -2 0\n3 2 2 0\n4 -2 2 0\n", n + 4);
+    let mut k = 4;
+    while k < n + 4 {
+        let (x, y, z) = (2.0 * next() - 1.0, 2.0 * next() - 1.0, 0.2 * next() - 0.1);
+        if z != 0.0 {
+            k += 1;
+            text += &format!("{k} {x:?} {y:?} {z:?}\n");
+        }
+    }
+    text += "1 0\n1\n4 1 2 3 4\n0\n0\n";
+    let file = tempfile::Builder::new().suffix(".poly").tempfile().unwrap();
+    std::fs::write(file.path(), text).unwrap();
+    file.into_temp_path()
+}
+
+/// A cavity large enough for its two sides to be triangulated on two threads (4,096
+/// tets and more) gives the flips' tets, as a small one does.
+#[test]
+fn a_cavity_triangulated_on_two_threads_gives_the_flips_tets() {
+    let path = figure_9_input(3000, 7);
+    let c = mesh(&path, "-pcQC");
+    let f = mesh(&path, "-pcQF");
+    let p = c.stats.plc.as_ref().unwrap();
+    assert!(
+        p.max_region_crossing_tets >= 4096,
+        "{}",
+        p.max_region_crossing_tets
+    );
+    assert_eq!(steiner(&c), 0);
+    assert_eq!(flips(&f).fallbacks, 0);
     assert_eq!(tets(&c), tets(&f));
 }
 

@@ -124,19 +124,46 @@ pub fn insert_region(
     let mut sides: [Option<SideDt>; 2] = [None, None];
     // Both sides' inner vertices, found again only after the cavity grows.
     let mut inner_verts: Option<[Vec<VertexId>; 2]> = None;
+    // A large cavity's two sides are triangulated at once, on two threads, as they are
+    // before any growth; a side's result is used only while the cavity has not grown.
+    let mut ahead: [Option<Result<SideDone, MeshError>>; 2] = [None, None];
+    if cavity.len() >= PARALLEL_SIDES {
+        let inner =
+            inner_verts.get_or_insert_with(|| inner_vertices(cdt, &cavity, &top, &bottom, &region));
+        let (points, orig) = (&cdt.dt.points[..], &cdt.dt.orig[..]);
+        let [top_all, bottom_all] = [
+            side_faces(&top, &region, false),
+            side_faces(&bottom, &region, true),
+        ];
+        let side = |all: Vec<CavFace>, inner: &[VertexId]| {
+            let sdt = delaunay_of_points(points, orig, &all, inner)?;
+            let missing = sdt.missing(&all);
+            Ok((all, sdt, missing))
+        };
+        let (a, b) = rayon::join(|| side(top_all, &inner[0]), || side(bottom_all, &inner[1]));
+        ahead = [Some(a), Some(b)];
+    }
     #[allow(clippy::needless_range_loop)] // `side` also selects the face list and lid
     for side in 0..2 {
         loop {
-            let (faces, lid_flip) = if side == 0 {
-                (&top, false)
-            } else {
-                (&bottom, true)
+            let (all, sdt, missing) = match ahead[side].take() {
+                // Taken only while the cavity is as it was (growth empties `ahead`).
+                Some(done) => done?,
+                None => {
+                    let (faces, lid_flip) = if side == 0 {
+                        (&top, false)
+                    } else {
+                        (&bottom, true)
+                    };
+                    let all = side_faces(faces, &region, lid_flip);
+                    let inner = inner_verts.get_or_insert_with(|| {
+                        inner_vertices(cdt, &cavity, &top, &bottom, &region)
+                    });
+                    let sdt = delaunay_of(cdt, &all, &inner[side])?;
+                    let missing = sdt.missing(&all);
+                    (all, sdt, missing)
+                }
             };
-            let all = side_faces(faces, &region, lid_flip);
-            let inner = inner_verts
-                .get_or_insert_with(|| inner_vertices(cdt, &cavity, &top, &bottom, &region));
-            let sdt = delaunay_of(cdt, &all, &inner[side])?;
-            let missing = sdt.missing(&all);
             if missing.is_empty() {
                 sides[side] = Some(sdt);
                 break;
@@ -173,6 +200,7 @@ pub fn insert_region(
                 cavity.push(outside);
                 enlarged += 1;
                 inner_verts = None;
+                ahead = [None, None];
             }
         }
     }
@@ -557,6 +585,10 @@ fn crosses(cdt: &Cdt, region: &Region, t: TetId) -> bool {
     region.crossed_by_tet(&cdt.dt.points, v)
 }
 
+/// Cavities of at least this many tets have their two sides triangulated on two threads
+/// (below it, starting a thread costs more than it saves).
+const PARALLEL_SIDES: usize = 4096;
+
 /// Work units ([`Cdt::work`], a crossing test each) per orientation test that needed
 /// adaptive arithmetic.
 const ADAPTIVE_WORK_UNITS: u64 = 32;
@@ -902,6 +934,10 @@ fn side_faces(faces: &[CavFace], region: &Region, flip: bool) -> Vec<CavFace> {
     all
 }
 
+/// One side's faces (with the region's triangles), its triangulation, and the indices
+/// of the faces that the triangulation lacks.
+type SideDone = (Vec<CavFace>, SideDt, Vec<usize>);
+
 /// The Delaunay tetrahedralization of one side's vertices, with the map between its
 /// vertex ids and the mesh's.
 struct SideDt {
@@ -918,11 +954,22 @@ struct SideDt {
 /// The Delaunay tetrahedralization of the vertices of `faces`, numbered in global
 /// perturbation order so that its ties are broken exactly as in the mesh.
 fn delaunay_of(cdt: &Cdt, faces: &[CavFace], inner: &[VertexId]) -> Result<SideDt, MeshError> {
+    delaunay_of_points(&cdt.dt.points, &cdt.dt.orig, faces, inner)
+}
+
+/// [`delaunay_of`] from the mesh's points and their perturbation indices alone (what
+/// another thread may share).
+fn delaunay_of_points(
+    points: &[Point],
+    orig: &[u32],
+    faces: &[CavFace],
+    inner: &[VertexId],
+) -> Result<SideDt, MeshError> {
     let mut gv: Vec<VertexId> = faces.iter().flat_map(|f| f.verts).collect();
     gv.extend_from_slice(inner);
-    gv.sort_unstable_by_key(|&v| cdt.dt.orig[v as usize]);
+    gv.sort_unstable_by_key(|&v| orig[v as usize]);
     gv.dedup();
-    let pts: Vec<Point> = gv.iter().map(|&v| cdt.dt.points[v as usize]).collect();
+    let pts: Vec<Point> = gv.iter().map(|&v| points[v as usize]).collect();
     let dt = Delaunay::build(&pts)?.dt;
     let global: Vec<VertexId> = dt.orig.iter().map(|&i| gv[i as usize]).collect();
     let local = global
