@@ -121,7 +121,8 @@ pub fn insert_region(
             }
         }
     };
-    let mut sides: [Option<SideDt>; 2] = [None, None];
+    // Each side's faces (with the region's triangles) and their triangulation.
+    let mut sides: [Option<(Vec<CavFace>, SideDt)>; 2] = [None, None];
     // Both sides' inner vertices, found again only after the cavity grows.
     let mut inner_verts: Option<[Vec<VertexId>; 2]> = None;
     // A large cavity's two sides are triangulated at once, on two threads, as they are
@@ -130,17 +131,11 @@ pub fn insert_region(
     if cavity.len() >= PARALLEL_SIDES {
         let inner =
             inner_verts.get_or_insert_with(|| inner_vertices(cdt, &cavity, &top, &bottom, &region));
-        let (points, orig) = (&cdt.dt.points[..], &cdt.dt.orig[..]);
-        let [top_all, bottom_all] = [
-            side_faces(&top, &region, false),
-            side_faces(&bottom, &region, true),
-        ];
-        let side = |all: Vec<CavFace>, inner: &[VertexId]| {
-            let sdt = delaunay_of_points(points, orig, &all, inner)?;
-            let missing = sdt.missing(&all);
-            Ok((all, sdt, missing))
-        };
-        let (a, b) = rayon::join(|| side(top_all, &inner[0]), || side(bottom_all, &inner[1]));
+        let (points, orig, tris) = (&cdt.dt.points[..], &cdt.dt.orig[..], &region.tris[..]);
+        let (a, b) = rayon::join(
+            || triangulate_side(points, orig, &top, tris, false, &inner[0]),
+            || triangulate_side(points, orig, &bottom, tris, true, &inner[1]),
+        );
         ahead = [Some(a), Some(b)];
     }
     #[allow(clippy::needless_range_loop)] // `side` also selects the face list and lid
@@ -150,22 +145,16 @@ pub fn insert_region(
                 // Taken only while the cavity is as it was (growth empties `ahead`).
                 Some(done) => done?,
                 None => {
-                    let (faces, lid_flip) = if side == 0 {
-                        (&top, false)
-                    } else {
-                        (&bottom, true)
-                    };
-                    let all = side_faces(faces, &region, lid_flip);
+                    let faces = if side == 0 { &top } else { &bottom };
                     let inner = inner_verts.get_or_insert_with(|| {
                         inner_vertices(cdt, &cavity, &top, &bottom, &region)
                     });
-                    let sdt = delaunay_of(cdt, &all, &inner[side])?;
-                    let missing = sdt.missing(&all);
-                    (all, sdt, missing)
+                    let (points, orig) = (&cdt.dt.points, &cdt.dt.orig);
+                    triangulate_side(points, orig, faces, &region.tris, side == 1, &inner[side])?
                 }
             };
             if missing.is_empty() {
-                sides[side] = Some(sdt);
+                sides[side] = Some((all, sdt));
                 break;
             }
             for m in missing {
@@ -204,17 +193,15 @@ pub fn insert_region(
             }
         }
     }
-    let [Some(dt_top), Some(dt_bot)] = sides else {
+    // Growing the bottom side never touches the top side's faces (`grow` refuses to),
+    // so the top side's faces and triangulation still hold.
+    let [Some(top_side), Some(bottom_side)] = sides else {
         return Err(MeshError::Internal(
             "a cavity side was not triangulated".into(),
         ));
     };
-    // Growing the bottom side never touches the top side's faces (`grow` refuses to),
-    // so the top side's triangulation still holds.
-    let top_faces = side_faces(&top, &region, false);
-    let bot_faces = side_faces(&bottom, &region, true);
     let mut new_tets = Vec::new();
-    for (sdt, faces) in [(&dt_top, &top_faces), (&dt_bot, &bot_faces)] {
+    for (faces, sdt) in [&top_side, &bottom_side] {
         for v in sdt.inside(faces)? {
             if v.iter().all(|x| region.verts.contains(x)) {
                 // A shim tet: four vertices on the polygon.
@@ -279,7 +266,7 @@ pub fn insert_region(
             }
         }
     }
-    graft(cdt, &cavity, &top_faces, &bot_faces, &new_tets)?;
+    graft(cdt, &cavity, &top_side.0, &bottom_side.0, &new_tets)?;
     let mut lost = Vec::new();
     at_risk.sort_unstable();
     at_risk.dedup();
@@ -923,20 +910,31 @@ fn inner_vertices(
     sides
 }
 
-/// The faces bounding one side: its cavity faces, and the region's triangles oriented so
-/// that the side lies on their positive side.
-fn side_faces(faces: &[CavFace], region: &Region, flip: bool) -> Vec<CavFace> {
-    let mut all = faces.to_vec();
-    for t in &region.tris {
-        let verts = if flip { [t[0], t[2], t[1]] } else { *t };
-        all.push(CavFace { verts, inner: None });
-    }
-    all
-}
-
 /// One side's faces (with the region's triangles), its triangulation, and the indices
 /// of the faces that the triangulation lacks.
 type SideDone = (Vec<CavFace>, SideDt, Vec<usize>);
+
+/// Triangulates one side of the cavity: its faces `faces`, the region's triangles `tris`
+/// oriented so that the side lies on their positive side (`flip` for the bottom), and its
+/// `inner` vertices. Needs only the mesh's points and perturbation indices, so that the
+/// two sides can be triangulated on two threads.
+fn triangulate_side(
+    points: &[Point],
+    orig: &[u32],
+    faces: &[CavFace],
+    tris: &[[VertexId; 3]],
+    flip: bool,
+    inner: &[VertexId],
+) -> Result<SideDone, MeshError> {
+    let mut all = faces.to_vec();
+    for t in tris {
+        let verts = if flip { [t[0], t[2], t[1]] } else { *t };
+        all.push(CavFace { verts, inner: None });
+    }
+    let sdt = delaunay_of(points, orig, &all, inner)?;
+    let missing = sdt.missing(&all);
+    Ok((all, sdt, missing))
+}
 
 /// The Delaunay tetrahedralization of one side's vertices, with the map between its
 /// vertex ids and the mesh's.
@@ -951,15 +949,10 @@ struct SideDt {
     faces: FxHashMap<[VertexId; 3], FaceRef>,
 }
 
-/// The Delaunay tetrahedralization of the vertices of `faces`, numbered in global
-/// perturbation order so that its ties are broken exactly as in the mesh.
-fn delaunay_of(cdt: &Cdt, faces: &[CavFace], inner: &[VertexId]) -> Result<SideDt, MeshError> {
-    delaunay_of_points(&cdt.dt.points, &cdt.dt.orig, faces, inner)
-}
-
-/// [`delaunay_of`] from the mesh's points and their perturbation indices alone (what
-/// another thread may share).
-fn delaunay_of_points(
+/// The Delaunay tetrahedralization of the vertices of `faces` and `inner` (mesh
+/// vertices, at `points`), numbered in global perturbation order (`orig`) so that its
+/// ties are broken exactly as in the mesh.
+fn delaunay_of(
     points: &[Point],
     orig: &[u32],
     faces: &[CavFace],

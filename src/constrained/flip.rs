@@ -945,6 +945,18 @@ impl<'a> Flipper<'a> {
         word
     }
 
+    /// A word of everything popping entry `n` reads (its event and its tets with their
+    /// generations), read only to bring it into the cache (see [`Flipper::pop`]).
+    #[inline]
+    fn entry_word(&self, n: &Entry) -> u32 {
+        let mesh = &self.cdt.dt.mesh;
+        let event = self
+            .events
+            .get(n.event() as usize)
+            .map_or(0, |ev| ev.verts[0]);
+        event ^ self.gens.of(n.t1) ^ self.gens.of(n.t2) ^ mesh.touch(n.t1) ^ mesh.touch(n.t2)
+    }
+
     /// The side of vertex `v` (0 on the polygon, and for the ghost), marked now if it
     /// was not: a neighbour of R may have a vertex that no crossing tet had.
     fn side_marked(&mut self, v: VertexId) -> i8 {
@@ -1157,17 +1169,10 @@ impl<'a> Flipper<'a> {
     fn pop(&mut self) -> Option<Entry> {
         self.with_queue(|q, fl| {
             let x = q.pop(fl);
-            // The next event's tets are cold (it was certified long ago): loading them
-            // now overlaps the misses with this event's flip.
+            // The next event is cold (it was certified long ago): reading it now
+            // overlaps its misses with this event's flip.
             if let Some(n) = q.peek() {
-                let mesh = &fl.cdt.dt.mesh;
-                let e = fl
-                    .events
-                    .get(n.event() as usize)
-                    .map_or(0, |ev| ev.verts[0]);
-                std::hint::black_box(
-                    e ^ fl.gens.of(n.t1) ^ fl.gens.of(n.t2) ^ mesh.touch(n.t1) ^ mesh.touch(n.t2),
-                );
+                std::hint::black_box(fl.entry_word(n));
             }
             x
         })
