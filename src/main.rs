@@ -32,6 +32,9 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -A     Give each tet the attribute of its region from the region list (needs -p)
   -M     Do not merge coplanar adjacent facets (needs -p)
   -S[n]  At most n Steiner points (-S or -S0: no limit); reaching it is an error
+  -J     Keep the input points that no tet uses (repeated points, points outside the
+         domain or in holes) in .node; by default they are left out, as TetGen does
+  -j     Leave those points out (the default; accepted for TetGen compatibility)
   -k     Also write the mesh as legacy VTK: <prefix>.vtk (region attribute as CELL_DATA)
   -g     Also write the mesh as Medit: <prefix>.mesh (subfaces as Triangles, tets with region ref)
   -O0    No mesh optimization (the only level we do; accepted for TetGen compatibility)
@@ -52,7 +55,9 @@ Progress bars appear on stderr when it is a terminal and a run takes over a seco
 (never with -Q or when CI is set).
 
 Output: <dir>/<base>.1.node, .ele, .face (and .edge, .neigh, .vtk, .mesh) next to the input; an input
-named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically.
+named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically. The nodes
+are the input points in input order, without those no tet uses (unless -J), then the
+Steiner points.
 
 Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
 3 invalid input, 4 I/O error. With several FILEs: the code of the first FILE (in

@@ -71,6 +71,9 @@ pub struct Options {
     pub vtk_output: bool,
     /// `-g`: also write the mesh as a Medit `.mesh` file.
     pub medit_output: bool,
+    /// `-J`: keep the input points that are in no tet (duplicates, points outside the
+    /// domain or in holes) in the output, instead of dropping them as TetGen does.
+    pub keep_unused: bool,
 }
 
 /// One thing wrong with the switches.
@@ -196,8 +199,6 @@ const REFUSED: &[(char, Arg, &str)] = &[
     ('W', Arg::None, "regular tetrahedralization"),
     ('x', Arg::Numbers, "memory size of blocks"),
     ('X', Arg::None, "inexact arithmetic"),
-    ('j', Arg::None, "jettison unused vertices"),
-    ('J', Arg::None, "no jettisoning of unused vertices"),
     ('B', Arg::None, "no boundary information in the output"),
     ('N', Arg::None, "no .node output"),
     ('E', Arg::None, "no .ele output"),
@@ -227,6 +228,7 @@ struct Seen {
     no_merge: bool,
     keep_hull: bool,
     regions: bool,
+    jettison: bool,
     problems: Vec<SwitchProblem>,
 }
 
@@ -338,6 +340,15 @@ impl Options {
                     seen.regions = true;
                     true
                 }
+                // TetGen's -j asks for what it does by default with -p (and we always).
+                'j' => {
+                    seen.jettison = true;
+                    true
+                }
+                'J' => {
+                    self.keep_unused = true;
+                    true
+                }
                 _ => false,
             };
             if simple {
@@ -432,6 +443,9 @@ impl Options {
         }
         if seen.cavity && seen.flip {
             seen.problems.push(SwitchProblem::Conflict('C', 'F'));
+        }
+        if seen.jettison && self.keep_unused {
+            seen.problems.push(SwitchProblem::Conflict('j', 'J'));
         }
         if !self.plc {
             for &(c, what) in NEED_PLC {
@@ -541,6 +555,15 @@ mod tests {
                 Options {
                     vtk_output: true,
                     medit_output: true,
+                    ..d()
+                },
+            ),
+            (&["-j"], d()),
+            (&["-pj"], Options { plc: true, ..d() }),
+            (
+                &["-J"],
+                Options {
+                    keep_unused: true,
                     ..d()
                 },
             ),
@@ -662,7 +685,8 @@ mod tests {
             (&["-K"], &["-K (VTK output with extras"]),
             (&["-G"], &["-G (GiD"]),
             (&["-k1"], &["-k does not take the argument \"1\""]),
-            (&["-J"], &["-J (no jettisoning"]),
+            (&["-jJ"], &["-j and -J exclude each other"]),
+            (&["-J5"], &["-J does not take the argument \"5\""]),
             (&["-B"], &["-B (no boundary"]),
             (&["-N"], &["-N (no .node"]),
             (&["-E"], &["-E (no .ele"]),
@@ -672,7 +696,6 @@ mod tests {
             (&["-L"], &["-L (flip-based"]),
             (&["-l"], &["-l (incremental flip"]),
             (&["-s"], &["-s (no Steiner"]),
-            (&["-j"], &["-j (jettison"]),
             (&["-u"], &["-u (random"]),
             (&["-v"], &["-v (Voronoi"]),
             (&["-h"], &["-h (help"]),

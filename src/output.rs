@@ -41,3 +41,129 @@ pub struct MeshOut {
     /// True when the exterior was kept (`-c`), so the boundary need not lie on polygons.
     pub convex_hull_kept: bool,
 }
+
+impl MeshOut {
+    /// The mesh without the nodes that no tet uses (duplicates of other points, points
+    /// outside the domain or in holes), renumbered in order, as TetGen writes its output
+    /// unless given `-J`; `None` if every node is used, or if there are no tets.
+    pub fn jettisoned(&self) -> Option<MeshOut> {
+        if self.tets.is_empty() {
+            return None;
+        }
+        let mut used = vec![false; self.points.len()];
+        for t in &self.tets {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        // Constrained faces and edges lie on tets; kept in case one ever does not.
+        for (f, _) in &self.subfaces {
+            f.iter().for_each(|&v| used[v as usize] = true);
+        }
+        for (e, _) in &self.subsegments {
+            e.iter().for_each(|&v| used[v as usize] = true);
+        }
+        if used.iter().all(|&u| u) {
+            return None;
+        }
+        let kept: Vec<usize> = (0..self.points.len()).filter(|&i| used[i]).collect();
+        let mut new_index = vec![u32::MAX; self.points.len()];
+        for (n, &i) in kept.iter().enumerate() {
+            new_index[i] = n as u32;
+        }
+        let map = |v: &u32| new_index[*v as usize];
+        let k = self.num_point_attrs;
+        Some(MeshOut {
+            points: kept.iter().map(|&i| self.points[i]).collect(),
+            point_attrs: kept
+                .iter()
+                .flat_map(|&i| {
+                    let row = self.point_attrs.get(i * k..(i + 1) * k);
+                    row.unwrap_or_default().iter().copied()
+                })
+                .collect(),
+            point_markers: self.point_markers.as_ref().map(|m| {
+                kept.iter()
+                    .map(|&i| m.get(i).copied().unwrap_or(0))
+                    .collect()
+            }),
+            tets: self.tets.iter().map(|t| t.map(|v| map(&v))).collect(),
+            hull_faces: self.hull_faces.iter().map(|f| f.map(|v| map(&v))).collect(),
+            subfaces: self
+                .subfaces
+                .iter()
+                .map(|(f, m)| (f.map(|v| map(&v)), *m))
+                .collect(),
+            subsegments: self
+                .subsegments
+                .iter()
+                .map(|(e, m)| (e.map(|v| map(&v)), *m))
+                .collect(),
+            neighbors: self.neighbors.clone(),
+            tet_attrs: self.tet_attrs.clone(),
+            ..*self
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two tets on five points, with an unused point before, between and after them.
+    fn with_unused() -> MeshOut {
+        let p = |x: f64| [x, x * x, 1.0 - x];
+        MeshOut {
+            points: vec![
+                p(9.0),
+                p(0.0),
+                p(1.0),
+                p(8.0),
+                p(2.0),
+                p(3.0),
+                p(4.0),
+                p(7.0),
+            ],
+            num_point_attrs: 1,
+            point_attrs: vec![90.0, 0.0, 10.0, 80.0, 20.0, 30.0, 40.0, 70.0],
+            point_markers: Some(vec![9, 0, 1, 8, 2, 3, 4, 7]),
+            tets: vec![[1, 2, 4, 5], [2, 4, 5, 6]],
+            neighbors: vec![[1, -1, -1, -1], [-1, -1, -1, 0]],
+            hull_faces: vec![[1, 2, 4]],
+            num_tet_attrs: 1,
+            tet_attrs: vec![1.0, 2.0],
+            subfaces: vec![([1, 2, 4], 5)],
+            subsegments: vec![([2, 6], 6)],
+            plc_mode: true,
+            first_index: 1,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn unused_nodes_are_dropped_and_the_rest_renumbered_in_order() {
+        let m = with_unused();
+        let j = m.jettisoned().expect("three nodes are unused");
+        let p = |x: f64| [x, x * x, 1.0 - x];
+        assert_eq!(j.points, vec![p(0.0), p(1.0), p(2.0), p(3.0), p(4.0)]);
+        assert_eq!(j.point_attrs, vec![0.0, 10.0, 20.0, 30.0, 40.0]);
+        assert_eq!(j.point_markers, Some(vec![0, 1, 2, 3, 4]));
+        assert_eq!(j.tets, vec![[0, 1, 2, 3], [1, 2, 3, 4]]);
+        assert_eq!(j.hull_faces, vec![[0, 1, 2]]);
+        assert_eq!(j.subfaces, vec![([0, 1, 2], 5)]);
+        assert_eq!(j.subsegments, vec![([1, 4], 6)]);
+        assert_eq!(j.neighbors, m.neighbors);
+        assert_eq!(j.tet_attrs, m.tet_attrs);
+        assert_eq!((j.first_index, j.plc_mode), (1, true));
+    }
+
+    #[test]
+    fn a_mesh_that_uses_every_node_is_left_alone() {
+        let mut m = with_unused();
+        m.points.truncate(7);
+        m.tets.push([0, 3, 2, 4]);
+        assert!(m.jettisoned().is_none());
+        m.tets.clear();
+        assert!(m.jettisoned().is_none());
+    }
+}

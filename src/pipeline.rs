@@ -130,6 +130,7 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
     let ps = done.stats;
     let stats = Stats {
         input_points: plc.points.len(),
+        duplicate_points: ps.duplicate_points,
         output_tets: ps.output_tets,
         delaunay_secs: ps.delaunay_secs,
         precheck_secs,

@@ -170,11 +170,29 @@ pub fn run_model(
         say.warn(w);
     }
 
+    // As TetGen (without -J): the output leaves out the points no tet uses and numbers
+    // the rest in order; the library's mesh keeps input point i at node i, which the
+    // check below relies on.
+    let jettisoned = if opts.keep_unused {
+        None
+    } else {
+        meshed.mesh.jettisoned()
+    };
+    let written = jettisoned.as_ref().unwrap_or(&meshed.mesh);
+    let unused = meshed.mesh.points.len() - written.points.len();
+    if unused > 0 && opts.verbose > 0 {
+        say!(say, "");
+        say!(
+            say,
+            "Points in no tet left out of the output: {unused} (duplicates, or outside the domain; -J keeps them)."
+        );
+    }
+
     bar.stage(Stage::Write);
     let out_start = Instant::now();
     say!(say, "");
     writer::write_files_with(
-        &meshed.mesh,
+        written,
         &prefix,
         &wopts,
         &mut |p: &Path| {
@@ -195,7 +213,7 @@ pub fn run_model(
     );
 
     if opts.verbose > 0 {
-        print_statistics(say, &meshed);
+        print_statistics(say, &meshed, written.points.len());
     }
     if let Some(path) = &opts.stats_json {
         let json = meshed.stats.to_json(&file.to_string_lossy());
@@ -214,7 +232,7 @@ pub fn run_model(
         say!(say, "Mesh check passed.");
     }
     Ok(Done {
-        points: meshed.mesh.points.len(),
+        points: written.points.len(),
         stats: meshed.stats,
     })
 }
@@ -241,7 +259,7 @@ fn detect_only(
 }
 
 /// The `-V` statistics (with `-p`, the rows of the paper's Table 1).
-fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed) {
+fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed, mesh_points: usize) {
     let s = &meshed.stats;
     say!(say, "");
     say!(say, "Statistics:");
@@ -249,7 +267,7 @@ fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed) {
     say!(say, "  Input points: {}", s.input_points);
     say!(say, "  Duplicate points: {}", s.duplicate_points);
     say!(say, "");
-    say!(say, "  Mesh points: {}", meshed.mesh.points.len());
+    say!(say, "  Mesh points: {mesh_points}");
     say!(say, "  Mesh tetrahedra: {}", s.output_tets);
     say!(say, "  Convex hull faces: {}", s.hull_faces);
     say!(say, "");

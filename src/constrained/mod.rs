@@ -125,6 +125,8 @@ pub struct PlcStats {
     pub input_points: usize,
     /// Input polygons.
     pub input_polygons: usize,
+    /// Input vertices merged with an earlier one at the same coordinates.
+    pub duplicate_points: usize,
     /// Steiner points added, in total.
     pub steiner_points: usize,
     /// Of those, the ones on polygons (for polygons that are not flat).
@@ -340,6 +342,7 @@ pub fn mesh_plc_with_progress(
         inserter: opts.inserter,
         input_points: plc.points.len(),
         input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
+        duplicate_points: prep.duplicates.len(),
         ..Default::default()
     };
     // Steiner points on polygons, found by earlier attempts: (merged facet, point); and
