@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Live comparison with TetGen on fresh random PLCs.
 
-usage: scripts/live-compare-plc.py [--cases N] [--seed S] [--keep DIR]
+usage: scripts/live-compare-plc.py [--cases N] [--seed S] [--keep DIR] [--big]
 
 Each case is a closed star-shaped surface: a latitude-longitude grid of 2 to 8 rings of
 3 to 14 points around the z axis, each point moved along its ray by up to 5%, 20% or
@@ -9,6 +9,8 @@ Each case is a closed star-shaped surface: a latitude-longitude grid of 2 to 8 r
 points inside its kernel; in half of the cases every coordinate is rounded to a grid of
 1/30, which makes points repeat and makes cospherical and coplanar ties. The seed
 changes on every run (from the clock) and is printed; `--seed S` repeats a run.
+--big draws finer surfaces instead (20 to 60 rings of 30 to 120 points, 0, 2,000 or
+20,000 points inside, no grid) and prints each program's wall time.
 
 For each case it runs `tetgen -pO0Q` (Debian TetGen 1.5), then `tetcdt -pQ` and
 `tetcdt -pQF`, and asks:
@@ -36,11 +38,14 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def star(rng):
+def star(rng, big=False):
     """(points, triangles) of a random star-shaped closed surface with points inside."""
-    nlat, nlon = rng.randint(2, 8), rng.randint(3, 14)
+    if big:
+        nlat, nlon = rng.randint(20, 60), rng.randint(30, 120)
+    else:
+        nlat, nlon = rng.randint(2, 8), rng.randint(3, 14)
     amp = rng.choice([0.05, 0.2, 0.4])
-    scale = rng.choice([0, 30])
+    scale = 0 if big else rng.choice([0, 30])
     pts, seen = [], set()
 
     def put(d, r):
@@ -91,7 +96,7 @@ def star(rng):
                 tris += [(a, c, d), (a, d, b)]
             else:
                 tris += [(a, c, b), (b, c, d)]
-    for _ in range(rng.choice([0, 20, 100, 400])):
+    for _ in range(rng.choice([0, 2000, 20000] if big else [0, 20, 100, 400])):
         while True:
             q = [rng.uniform(-1, 1) for _ in range(3)]
             if sum(x * x for x in q) < 1:
@@ -127,12 +132,17 @@ def mesh(prefix):
     return pts, tets
 
 
-def run(cmd, cwd, timeout):
+def run(cmd, cwd, timeout, times=None):
+    """The command's exit code (or "timeout"); its wall time appended to `times`."""
+    start = time.monotonic()
     try:
-        return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True,
-                              timeout=timeout).returncode
+        rc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True,
+                            timeout=timeout).returncode
     except subprocess.TimeoutExpired:
-        return "timeout"
+        rc = "timeout"
+    if times is not None:
+        times.append(time.monotonic() - start)
+    return rc
 
 
 def intersecting(work, name):
@@ -147,6 +157,8 @@ def main():
         print(__doc__)
         return 0
     opts = {"--cases": "12", "--seed": None, "--keep": None}
+    big = "--big" in args
+    args = [a for a in args if a != "--big"]
     while args:
         k = args.pop(0)
         if k not in opts or not args:
@@ -166,19 +178,20 @@ def main():
     if shutil.which("tetgen") is None:
         sys.exit("live-compare-plc.py: FAIL: tetgen is not on PATH (apt-get install tetgen)")
     print(f"live-compare-plc: seed {seed} (repeat: scripts/live-compare-plc.py --seed {seed} "
-          f"--cases {opts['--cases']})")
+          f"--cases {opts['--cases']}{' --big' if big else ''})")
     work = opts["--keep"] or tempfile.mkdtemp(prefix="tetcdt-live-plc.")
     os.makedirs(work, exist_ok=True)
     rng = random.Random(seed)
     failed, identical, tg_failed, refused = [], 0, 0, 0
     for case in range(int(opts["--cases"])):
         name = f"star{case}"
-        pts, tris = star(rng)
+        pts, tris = star(rng, big)
         inp = os.path.join(work, name + ".poly")
         write_poly(inp, pts, tris)
         distinct = {tuple(float(c) for c in p) for p in pts}
         problems, notes = [], []
-        tg = run(["tetgen", "-pO0Q", name + ".poly"], work, timeout)
+        times = []
+        tg = run(["tetgen", "-pO0Q", name + ".poly"], work, timeout, times)
         tg_mesh = None
         if tg == 0:
             tg_mesh = mesh(os.path.join(work, name + ".1"))
@@ -191,7 +204,7 @@ def main():
             notes.append(f"TetGen exit {tg}")
         for sw, tag in (("-pQ", "C"), ("-pQF", "F")):
             prefix = os.path.join(work, f"{name}.{tag}")
-            rc = run([tetcdt, sw, "-o", prefix, inp], work, timeout)
+            rc = run([tetcdt, sw, "-o", prefix, inp], work, timeout, times)
             if rc == 3 and intersecting(work, name):
                 # Rounding to the grid folded a thin triangle through another: the
                 # input is invalid, as TetGen's -d confirms, and refusing it is right.
@@ -214,6 +227,9 @@ def main():
                 else:
                     problems.append(f"tetcdt {sw}: {len(ours[1] - tg_mesh[1])} tets not TetGen's, "
                                     f"{len(tg_mesh[1] - ours[1])} of TetGen's missing")
+        if big:
+            names = ["TetGen", "C", "F"][-len(times):] if tg == 0 else ["TetGen", "C", "F"]
+            notes.append("seconds: " + ", ".join(f"{n} {t:.2f}" for n, t in zip(names, times)))
         status = "FAIL" if problems else "ok"
         print(f"  {name}: {len(pts)} points, {len(tris)} triangles; {', '.join(notes)}: {status}")
         for p in problems:
