@@ -51,17 +51,13 @@ impl MeshOut {
             return None;
         }
         let mut used = vec![false; self.points.len()];
-        for t in &self.tets {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
+        let tets = self.tets.iter().flatten();
         // Constrained faces and edges lie on tets; kept in case one ever does not.
-        for (f, _) in &self.subfaces {
-            f.iter().for_each(|&v| used[v as usize] = true);
-        }
-        for (e, _) in &self.subsegments {
-            e.iter().for_each(|&v| used[v as usize] = true);
+        let faces = self.subfaces.iter().flat_map(|(f, _)| f);
+        let edges = self.subsegments.iter().flat_map(|(e, _)| e);
+        for &v in tets.chain(faces).chain(edges) {
+            // A node that does not exist leaves the mesh as it is (the checker names it).
+            *used.get_mut(v as usize)? = true;
         }
         if used.iter().all(|&u| u) {
             return None;
@@ -164,6 +160,13 @@ mod tests {
         m.tets.push([0, 3, 2, 4]);
         assert!(m.jettisoned().is_none());
         m.tets.clear();
+        assert!(m.jettisoned().is_none());
+    }
+
+    #[test]
+    fn a_node_out_of_range_leaves_the_mesh_alone() {
+        let mut m = with_unused();
+        m.tets.push([0, 1, 2, 99]);
         assert!(m.jettisoned().is_none());
     }
 }
