@@ -733,6 +733,34 @@ fn refused_steiner_points_split_subsegments_in_place_instead_of_restarting() {
     }
 }
 
+#[test]
+fn a_cavity_the_region_does_not_split_widens_over_the_meshs_other_triangulation() {
+    // In rotor_small, a region of a facet split by rounded Steiner points on its edges
+    // is partly triangulated otherwise by mesh faces that no tet crosses: its crossing
+    // tets' boundary is one piece, which the region's boundary does not split. The tets
+    // on both sides of those faces now join the cavity, where a Steiner point on the
+    // polygon (refused by the CDT, and put in by updates in place) was asked for: 3
+    // points on polygons instead of 4, 572 Steiner points instead of 579.
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/rotor_small.off");
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = dir.path().join("rotor_small");
+    let json = dir.path().join("rotor_small.json");
+    let (code, err) = run(
+        &m,
+        &prefix,
+        &["-pQ", "--check", "--stats-json", json.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{err}");
+    let stats = std::fs::read_to_string(&json).unwrap();
+    assert!(json_number(&stats, "facet_steiner_points") <= 3, "{stats}");
+    assert!(json_number(&stats, "steiner_points") <= 572, "{stats}");
+    if let Some(script) = validator() {
+        if let Err(report) = referee(&script, &m, &prefix, &[]) {
+            panic!("{report}");
+        }
+    }
+}
+
 /// STL models on which our CDT and TetGen's differ only by the numbering of the welded
 /// points (`data/stl_numbering/README.md`): numbered as TetGen numbers them, our tets are
 /// TetGen's; numbered by first appearance, as we read STL, the mesh is valid and has the

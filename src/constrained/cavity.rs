@@ -92,10 +92,38 @@ pub fn insert_region(
     }
     let mut enlarged = 0;
     let mut bubbles = Vec::new();
+    let mut widened = false;
     let (mut top, mut bottom) = loop {
         bubbles.clear();
         if let Some(sides) = split_sides(cdt, &region, &cavity, &in_cav, &mut bubbles)? {
             break sides;
+        }
+        if bubbles.is_empty() && !widened {
+            // The region's boundary does not split the cavity: where part of the
+            // region, a rounding off flat, is triangulated otherwise by faces that no
+            // tet crosses, the sides join around it. The tets on both sides of those
+            // faces join the cavity, which then covers the whole region.
+            widened = true;
+            let more = other_triangulation(cdt, &region, normal);
+            let mut added = false;
+            for t in more {
+                if cdt.is_ghost(t) {
+                    return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
+                }
+                if in_cav.insert(t) {
+                    cavity.push(t);
+                    enlarged += 1;
+                    added = true;
+                }
+            }
+            if added {
+                if std::env::var_os("TETCDT_DEBUG").is_some() {
+                    eprintln!(
+                        "facet {facet}: cavity widened over another triangulation of the region"
+                    );
+                }
+                continue;
+            }
         }
         if bubbles.is_empty() {
             return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
@@ -852,6 +880,53 @@ fn surface_neighbor(
     Err(MeshError::Internal(
         "turning around a cavity edge did not end".into(),
     ))
+}
+
+/// The tets on both sides of the mesh faces that join three of the region's vertices,
+/// are no triangle of it, and lie within it (their centroid inside one of its triangles,
+/// seen along `normal`): another triangulation of part of the region.
+fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetId> {
+    let mesh = &cdt.dt.mesh;
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    let ax = (0..3)
+        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+        .unwrap_or(2);
+    let (u, w) = ((ax + 1) % 3, (ax + 2) % 3);
+    let flat = |q: Point| [q[u], q[w]];
+    let inside = |q: [f64; 2], t: &[VertexId; 3]| {
+        let [a, b, c] = t.map(|v| flat(p(v)));
+        let side = |x: [f64; 2], y: [f64; 2]| {
+            (y[0] - x[0]) * (q[1] - x[1]) - (y[1] - x[1]) * (q[0] - x[0])
+        };
+        let s = [side(a, b), side(b, c), side(c, a)];
+        s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
+    };
+    let keys: FxHashSet<[VertexId; 3]> = region.tris.iter().map(|t| face_key(*t)).collect();
+    let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
+    verts.sort_unstable();
+    let mut star = Vec::new();
+    let mut out = Vec::new();
+    for &v in &verts {
+        cdt.dt.star(v, &mut star);
+        for &t in &star {
+            for i in 0..4 {
+                let f = mesh.face_verts(t, i);
+                if f.contains(&v)
+                    && f.iter().all(|x| region.verts.contains(x))
+                    && !keys.contains(&face_key(f))
+                {
+                    let c = [0, 1, 2].map(|k| (p(f[0])[k] + p(f[1])[k] + p(f[2])[k]) / 3.0);
+                    if region.tris.iter().any(|rt| inside(flat(c), rt)) {
+                        out.push(t);
+                        out.push(mesh.adj(FaceRef::new(t, i)).tet());
+                    }
+                }
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// The vertices inside the cavity (on none of its boundary faces), above and below the
