@@ -884,7 +884,9 @@ fn surface_neighbor(
 
 /// The tets on both sides of the mesh faces that join three of the region's vertices,
 /// are no triangle of it, and lie within it (their centroid inside one of its triangles,
-/// seen along `normal`): another triangulation of part of the region.
+/// seen along `normal`): another triangulation of part of the region. The inside test
+/// is in floating point: it only chooses tets to retriangulate, which the exact cavity
+/// code then checks as it does any cavity.
 fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetId> {
     let mesh = &cdt.dt.mesh;
     let p = |v: VertexId| cdt.dt.points[v as usize];
