@@ -318,18 +318,55 @@ pub fn insert_region(
     }))
 }
 
+/// Orientations of points seen along a facet's normal: in the plane of the two other
+/// axes than its largest component.
+struct Seen {
+    u: usize,
+    w: usize,
+}
+
+impl Seen {
+    fn along(normal: [f64; 3]) -> Self {
+        let axis = (0..3)
+            .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
+            .unwrap_or(2);
+        Seen {
+            u: (axis + 1) % 3,
+            w: (axis + 2) % 3,
+        }
+    }
+
+    /// The exact orientation of `a`, `b`, `c` as seen.
+    fn orient(&self, a: &Point, b: &Point, c: &Point) -> f64 {
+        let co = |q: &Point| robust::Coord {
+            x: q[self.u],
+            y: q[self.w],
+        };
+        robust::orient2d(co(a), co(b), co(c))
+    }
+
+    /// Is `q` strictly inside one of the triangles `tris` (of the mesh's `points`)?
+    fn inside_any(&self, points: &[Point], tris: &[[VertexId; 3]], q: &Point) -> bool {
+        tris.iter().any(|t| {
+            let [x, y, z] = t.map(|v| &points[v as usize]);
+            let s = [
+                self.orient(x, y, q),
+                self.orient(y, z, q),
+                self.orient(z, x, q),
+            ];
+            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+        })
+    }
+}
+
 /// The mesh faces that triangulate the region when no tet crosses it: a flood over mesh
 /// faces with all vertices on the region, from its boundary edges inward (sides told
 /// apart in the facet's projection). `None` if they do not make up a triangulation of it.
 fn adopt(cdt: &mut Cdt, region: &Region, normal: [f64; 3]) -> Option<Vec<[VertexId; 3]>> {
-    let axis = (0..3).max_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))?;
-    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+    let seen = Seen::along(normal);
     let o2 = |a: VertexId, b: VertexId, c: VertexId| {
-        let p = |v: VertexId| {
-            let q = cdt.dt.points[v as usize];
-            robust::Coord { x: q[u], y: q[w] }
-        };
-        robust::orient2d(p(a), p(b), p(c))
+        let p = |v: VertexId| &cdt.dt.points[v as usize];
+        seen.orient(p(a), p(b), p(c))
     };
     // Candidate faces around every region vertex.
     let mut cand: FxHashSet<[VertexId; 3]> = FxHashSet::default();
@@ -884,25 +921,11 @@ fn surface_neighbor(
 
 /// The tets on both sides of the mesh faces that join three of the region's vertices,
 /// are no triangle of it, and lie within it (their centroid inside one of its triangles,
-/// seen along `normal`): another triangulation of part of the region. The inside test
-/// is in floating point: it only chooses tets to retriangulate, which the exact cavity
-/// code then checks as it does any cavity.
+/// seen along `normal`): another triangulation of part of the region.
 fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetId> {
     let mesh = &cdt.dt.mesh;
     let p = |v: VertexId| cdt.dt.points[v as usize];
-    let ax = (0..3)
-        .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-        .unwrap_or(2);
-    let (u, w) = ((ax + 1) % 3, (ax + 2) % 3);
-    let flat = |q: Point| [q[u], q[w]];
-    let inside = |q: [f64; 2], t: &[VertexId; 3]| {
-        let [a, b, c] = t.map(|v| flat(p(v)));
-        let side = |x: [f64; 2], y: [f64; 2]| {
-            (y[0] - x[0]) * (q[1] - x[1]) - (y[1] - x[1]) * (q[0] - x[0])
-        };
-        let s = [side(a, b), side(b, c), side(c, a)];
-        s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
-    };
+    let seen = Seen::along(normal);
     let keys: FxHashSet<[VertexId; 3]> = region.tris.iter().map(|t| face_key(*t)).collect();
     let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
     verts.sort_unstable();
@@ -918,7 +941,7 @@ fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetI
                     && !keys.contains(&face_key(f))
                 {
                     let c = [0, 1, 2].map(|k| (p(f[0])[k] + p(f[1])[k] + p(f[2])[k]) / 3.0);
-                    if region.tris.iter().any(|rt| inside(flat(c), rt)) {
+                    if seen.inside_any(&cdt.dt.points, &region.tris, &c) {
                         out.push(t);
                         out.push(mesh.adj(FaceRef::new(t, i)).tet());
                     }
@@ -1268,23 +1291,7 @@ pub(crate) fn steiner_point(
             / nn;
         let q: Point = std::array::from_fn(|k| cc[k] - off * normal[k]);
         // Inside a region triangle, seen along the normal?
-        let axis = (0..3)
-            .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-            .unwrap_or(2);
-        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-        let o2 = |x: Point, y: Point, z: Point| {
-            robust::orient2d(
-                robust::Coord { x: x[u], y: x[w] },
-                robust::Coord { x: y[u], y: y[w] },
-                robust::Coord { x: z[u], y: z[w] },
-            )
-        };
-        let inside = tris.iter().any(|t| {
-            let (x, y, z) = (p(t[0]), p(t[1]), p(t[2]));
-            let s = [o2(x, y, q), o2(y, z, q), o2(z, x, q)];
-            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
-        });
-        if inside {
+        if Seen::along(normal).inside_any(&cdt.dt.points, tris, &q) {
             return q;
         }
     }
