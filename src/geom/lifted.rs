@@ -7,10 +7,12 @@
 //! The face flips at `τ = -I/J` if `J > 0` (Equation 1), and never otherwise.
 //!
 //! Comparing two flip times is the sign of `I₂·J₁ − I₁·J₂`: an interval-arithmetic filter
-//! first, then floating-point expansions. Exact ties are broken by TetGen's symbolic
-//! perturbation of the lift (lower index, larger infinitesimal lowering), the same one
-//! that [`insphere_sos`](super::insphere_sos) applies, so the flips keep the canonical
-//! triangulation and no two events are ever simultaneous unless they are the same event.
+//! first, then floating-point expansions. A certificate's exact `I` and `J`, once computed,
+//! also give it a tight interval, so that it rarely needs exact products again. Exact ties
+//! are broken by TetGen's symbolic perturbation of the lift (lower index, larger
+//! infinitesimal lowering), the same one that [`insphere_sos`](super::insphere_sos)
+//! applies, so the flips keep the canonical triangulation and no two events are ever
+//! simultaneous unless they are the same event.
 
 use super::expansion::Expansion;
 use super::Point;
@@ -35,6 +37,21 @@ const ERR: f64 = 3.0e-15;
 const RANGE: (f64, f64) = (1e-120, 1e120);
 
 impl Approx {
+    /// The value of `x` rounded, with a permanent whose error bound (`ERR` times it)
+    /// covers the rounding: the rest `x − v` is bounded by the sum of its components'
+    /// magnitudes, rounded up.
+    fn of_exact(x: &Expansion) -> Self {
+        let v = x.estimate();
+        let rest = x.sub(&Expansion::from_f64(v));
+        let n = rest.components().len() as f64;
+        let bound = rest.components().iter().map(|c| c.abs()).sum::<f64>()
+            * (1.0 + 2.0 * (n + 1.0) * f64::EPSILON);
+        Approx {
+            v,
+            p: bound / ERR * (1.0 + 1e-12),
+        }
+    }
+
     /// The error bound, or `None` when the value is outside the range of the analysis.
     #[inline]
     fn err(&self) -> Option<f64> {
@@ -275,6 +292,9 @@ struct Exact {
     i: Expansion,
     j: Expansion,
     minors: [Expansion; 4],
+    /// `i` and `j` rounded, with bounds as tight as the rounding: an interval or a key made
+    /// from these settles nearly every later comparison without the products.
+    rounded: (Approx, Approx),
 }
 
 /// Counts of how the comparisons were decided (for tuning and tests).
@@ -369,10 +389,13 @@ impl FlipTime {
             let h: [Expansion; 5] =
                 std::array::from_fn(|k| lift.height(&self.pts[k], self.left[k]));
             let minors = minors(&d);
+            let (i, j) = (insphere_with(&d, &minors), height_with(&minors, &h));
+            let rounded = (Approx::of_exact(&i), Approx::of_exact(&j));
             Box::new(Exact {
-                i: insphere_with(&d, &minors),
-                j: height_with(&minors, &h),
+                i,
+                j,
                 minors,
+                rounded,
             })
         })
     }
@@ -424,8 +447,15 @@ pub fn cross_sign(a: &FlipTime, b: &FlipTime, lift: &Lifting, counts: &mut Compa
         // The same five lifted points: the same hyperplane, the same event.
         return 0;
     }
-    counts.exact += 1;
     let (ea, eb) = (a.exact(lift), b.exact(lift));
+    // The filter again, on the exact values rounded: the floating-point evaluation of a
+    // nearly flat certificate (four vertices of the polygon in one minor) may not even
+    // have J's sign, while the two flip times are far apart.
+    if let Some(s) = key_cross(&a.key(), &b.key()) {
+        counts.filtered += 1;
+        return s;
+    }
+    counts.exact += 1;
     let (ia, ja, ib, jb) = (&ea.i, &ea.j, &eb.i, &eb.j);
     let len = |x: &Expansion, y: &Expansion| (x.components().len() + y.components().len()) as u64;
     counts.exact_work += len(ia, ja) * len(ib, jb);
@@ -463,11 +493,21 @@ struct TimeKey {
 impl FlipTime {
     /// The compact key of this flip time.
     fn key(&self) -> TimeKey {
+        let (i, j) = self.values();
         TimeKey {
-            i: self.i.v,
-            j: self.j.v,
-            ei: self.i.err().unwrap_or(f64::NAN),
-            ej: self.j.err().unwrap_or(f64::NAN),
+            i: i.v,
+            j: j.v,
+            ei: i.err().unwrap_or(f64::NAN),
+            ej: j.err().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// `I` and `J` as tightly as they are known: rounded from the exact values once those
+    /// were needed, else as evaluated in floating point.
+    fn values(&self) -> (Approx, Approx) {
+        match self.exact.get() {
+            Some(e) => e.rounded,
+            None => (self.i, self.j),
         }
     }
 }
@@ -477,7 +517,8 @@ impl FlipTime {
     /// positive or the values leave the analysed range): most heap comparisons are
     /// settled by two of these, with two float comparisons.
     pub fn interval(&self) -> (f64, f64) {
-        interval_of(&self.i, &self.j)
+        let (i, j) = self.values();
+        interval_of(&i, &j)
     }
 }
 
@@ -860,5 +901,105 @@ mod tests {
             return;
         }
         DECIDED.with(|d| d.set(d.get() + 1));
+    }
+
+    /// The rounding of an exact value is within the error bound it claims, on products
+    /// and sums of random values of many magnitudes (the rest is checked exactly).
+    #[test]
+    fn exact_values_round_within_their_bound() {
+        let mut s = 11u64;
+        for _ in 0..3000 {
+            let mut x = Expansion::zero();
+            for _ in 0..4 {
+                let mag = 2f64.powi((lcg(&mut s) * 60.0) as i32 - 30);
+                let a = Expansion::from_f64((lcg(&mut s) - 0.5) * mag);
+                let b = Expansion::from_f64(lcg(&mut s) - 0.5 + f64::EPSILON * lcg(&mut s));
+                x = x.add(&a.mul(&b));
+            }
+            let r = Approx::of_exact(&x);
+            let e = r.err().unwrap();
+            let rest = x.sub(&Expansion::from_f64(r.v));
+            assert!(rest.sub(&Expansion::from_f64(e)).sign() <= 0, "{x:?}");
+            assert!(rest.add(&Expansion::from_f64(e)).sign() >= 0, "{x:?}");
+        }
+    }
+
+    /// Two certificates from a fine folded surface (`live-compare-plc.py --big`), each with
+    /// one left vertex and four nearly coplanar points of the polygon: in floating point
+    /// even the sign of `J` is lost. Once their exact values are known their intervals are
+    /// tight, and comparing them (their times differ 26-fold) needs no exact products.
+    #[test]
+    fn nearly_flat_certificates_get_tight_intervals_from_their_exact_values() {
+        let lift = Lifting {
+            abc: [
+                [
+                    0.05546202341366163,
+                    0.002944420733223551,
+                    -1.0066807835160518,
+                ],
+                [
+                    0.0305116708410871,
+                    0.003476613126320699,
+                    -1.0127440452905843,
+                ],
+                [
+                    0.04625035864524529,
+                    0.005269937683864016,
+                    -1.0262795379483962,
+                ],
+            ],
+        };
+        let [p0, p1, p2] = lift.abc;
+        let q: [Point; 5] = [
+            [0.0553641751483994, 0.00732858427324465, -1.0126334118437166],
+            [
+                0.04885609164558194,
+                -0.0033171022142907546,
+                -1.018362479768785,
+            ],
+            [
+                0.03443165256490832,
+                -0.002337749646314077,
+                -1.008956349467558,
+            ],
+            [
+                0.05581077227503788,
+                0.007051298445018789,
+                -1.0199285048543425,
+            ],
+            p0,
+        ];
+        let certs = [
+            (
+                [q[0], p1, q[1], q[2], p2],
+                [10644, 11673, 11159, 11672, 11161],
+            ),
+            (
+                [q[0], p2, q[1], p1, q[3]],
+                [10644, 11161, 11159, 11673, 14451],
+            ),
+        ]
+        .map(|(p, ids)| {
+            let left = p.map(|x| lift.side(&x) > 0);
+            let h = std::array::from_fn(|k| lift.height_approx(&p[k], left[k]));
+            assert!(FlipTime::new(p, ids, left, h).j.sign().is_none());
+            FlipTime::if_flips(&lift, p, ids, left, h).expect("the face flips")
+        });
+        for t in &certs {
+            let (lo, hi) = t.interval();
+            let e = t.exact(&lift);
+            let tau = -e.i.estimate() / e.j.estimate();
+            assert!(
+                lo <= tau && tau <= hi && hi - lo <= 1e-12 * tau,
+                "{lo} {tau} {hi}"
+            );
+        }
+        let [a, b] = &certs;
+        let (ea, eb) = (a.exact(&lift), b.exact(&lift));
+        let want = eb.i.mul(&ea.j).sub(&ea.i.mul(&eb.j)).sign();
+        assert_eq!(want, -1);
+        let mut counts = CompareCounts::default();
+        assert_eq!(cross_sign(a, b, &lift, &mut counts), want);
+        assert_eq!((counts.filtered, counts.exact), (1, 0), "{counts:?}");
     }
 }
