@@ -761,6 +761,39 @@ fn a_cavity_the_region_does_not_split_widens_over_the_meshs_other_triangulation(
     }
 }
 
+#[test]
+fn subsegments_at_a_sharp_corner_that_encroach_upon_each_other_split_in_place_together() {
+    // In fine_star, a refused Steiner point on a polygon encroaches upon a subsegment
+    // whose middle would remove a subsegment of a neighbouring segment, and that one's
+    // middle the first: both are split at one distance from the segments' shared end,
+    // in place, where the construction used to restart.
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/fine_star.poly");
+    let dir = tempfile::tempdir().unwrap();
+    for sw in ["-pQ", "-pQF"] {
+        let prefix = dir.path().join("fine_star");
+        let json = dir.path().join("fine_star.json");
+        let (code, err) = run(
+            &m,
+            &prefix,
+            &[sw, "--check", "--stats-json", json.to_str().unwrap()],
+        );
+        assert_eq!(code, 0, "{err}");
+        let stats = std::fs::read_to_string(&json).unwrap();
+        assert_eq!(json_number(&stats, "restarts"), 0, "{sw} {stats}");
+        assert_eq!(json_number(&stats, "in_place_splits"), 1, "{sw} {stats}");
+        assert_eq!(
+            json_number(&stats, "facet_steiner_points"),
+            0,
+            "{sw} {stats}"
+        );
+        if let Some(script) = validator() {
+            if let Err(report) = referee(&script, &m, &prefix, &[]) {
+                panic!("{sw}: {report}");
+            }
+        }
+    }
+}
+
 /// STL models on which our CDT and TetGen's differ only by the numbering of the welded
 /// points (`data/stl_numbering/README.md`): numbered as TetGen numbers them, our tets are
 /// TetGen's; numbered by first appearance, as we read STL, the mesh is valid and has the

@@ -854,9 +854,11 @@ fn attempt(
                                 }
                             }
                         }
+                        let mut points = 1;
                         let facets = match (split, unrecovered) {
-                            (Some((facets, at_split)), _) => {
-                                carried.0.push(at_split);
+                            (Some((facets, at_splits)), _) => {
+                                points = at_splits.len() as u32;
+                                carried.0.extend(at_splits);
                                 Some(facets)
                             }
                             (None, Some((v, facets))) => {
@@ -869,12 +871,19 @@ fn attempt(
                                 stats.facet_steiner_points += 1;
                                 Some(facets)
                             }
-                            (None, None) => None,
+                            (None, None) => {
+                                if debug() {
+                                    eprintln!(
+                                        "facet {fi}: no update in place (allowed {update}, refused for {refused:?})"
+                                    );
+                                }
+                                None
+                            }
                         };
                         if let Some(facets) = facets {
                             ends = None;
-                            next_pert += 1;
-                            stats.steiner_points += 1;
+                            next_pert += points;
+                            stats.steiner_points += points as usize;
                             stats.in_place_splits += 1;
                             in_place += 1;
                             if in_place == 1 {
@@ -1493,8 +1502,9 @@ struct Segs<'a> {
 /// polygon) would remove (`lost`, when known) or else encroaches upon most closely, at
 /// its middle (perturbation index `pert`).
 /// The facets through it lose their subfaces, which the caller triangulates and
-/// recovers again; they are returned. `None`, with nothing changed, if `p` encroaches
-/// upon no subsegment or the CDT refuses the split point too.
+/// recovers again; they are returned, with the splits made (one, or two for
+/// [`split_pair`]). `None`, with nothing changed, if `p` encroaches upon no subsegment or
+/// the CDT refuses the split point too.
 #[allow(clippy::too_many_arguments)] // the recursion passes them all on
 fn split_encroached(
     cdt: &mut Cdt,
@@ -1505,7 +1515,7 @@ fn split_encroached(
     seg_index: &FxHashMap<(u32, u32), usize>,
     pert: u32,
     depth: usize,
-) -> Result<Option<(Vec<usize>, SegmentSplit)>, MeshError> {
+) -> Result<Option<InPlaceSplit>, MeshError> {
     let pt = |x: VertexId| cdt.dt.points[x as usize];
     // Inside the diametral sphere: the angle at `p` is obtuse. The closest such
     // subsegment (by distance to its middle) is the one to split.
@@ -1534,16 +1544,7 @@ fn split_encroached(
     if m == pt(u) || m == pt(v) {
         return Ok(None);
     }
-    let facets = segs.facets_of.get_or_insert_with(|| {
-        let mut of = vec![Vec::new(); prep.segments.len()];
-        for_each_facet_segment(prep, seg_index, |fi, si| {
-            if of[si].last() != Some(&fi) {
-                of[si].push(fi);
-            }
-        });
-        of
-    });
-    let through: Vec<usize> = facets[seg].clone();
+    let through = facets_through(segs, prep, seg_index, &[seg]);
     // The facets through the subsegment are unrecovered: their subfaces would wall the
     // split point's cavity in on both sides. Kept to be put back if it is refused.
     let removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
@@ -1555,16 +1556,20 @@ fn split_encroached(
         cdt.subfaces.extend(removed);
         segs.markers.insert((u, v), marker);
         cdt.subsegs.insert((u, v), marker);
+        let free::Inserted::Refused { lost: Some(e), .. } = inserted else {
+            return Ok(None);
+        };
+        if e == (u, v) || depth >= MAX_SPLIT_DEPTH {
+            return Ok(None);
+        }
+        // Two subsegments at a sharp corner encroach upon each other's middles: both
+        // are split at once, at one distance from the corner.
+        if let Some(done) = split_pair(cdt, (u, v), e, segs, prep, seg_index, pert)? {
+            return Ok(Some(done));
+        }
         // A split point that would remove another subsegment splits that one instead,
         // a few levels deep (a chain of encroachments, as in Ruppert's refinement).
-        return match inserted {
-            free::Inserted::Refused { lost: Some(e), .. }
-                if e != (u, v) && depth < MAX_SPLIT_DEPTH =>
-            {
-                split_encroached(cdt, m, Some(e), segs, prep, seg_index, pert, depth + 1)
-            }
-            _ => Ok(None),
-        };
+        return split_encroached(cdt, m, Some(e), segs, prep, seg_index, pert, depth + 1);
     };
     if debug() {
         eprintln!("split subsegment {u}-{v} in place at {m:?}: facets {through:?} again");
@@ -1583,7 +1588,159 @@ fn split_encroached(
         segs.markers.insert(e, marker);
         cdt.subsegs.insert(e, marker);
     }
-    Ok(Some((through, (seg, s))))
+    Ok(Some((through, vec![(seg, s)])))
+}
+
+/// An update in place by splits: the facets to triangulate and recover again, and the
+/// splits made (carried into a restart, if one comes).
+type InPlaceSplit = (Vec<usize>, Vec<SegmentSplit>);
+
+/// The facets through the segments `of` (their lists made when first needed).
+fn facets_through(
+    segs: &mut Segs<'_>,
+    prep: &PreparedPlc,
+    seg_index: &FxHashMap<(u32, u32), usize>,
+    of: &[usize],
+) -> Vec<usize> {
+    let facets = segs.facets_of.get_or_insert_with(|| {
+        let mut of = vec![Vec::new(); prep.segments.len()];
+        for_each_facet_segment(prep, seg_index, |fi, si| {
+            if of[si].last() != Some(&fi) {
+                of[si].push(fi);
+            }
+        });
+        of
+    });
+    let mut through: Vec<usize> = of.iter().flat_map(|&g| facets[g].iter().copied()).collect();
+    through.sort_unstable();
+    through.dedup();
+    through
+}
+
+/// Splits in place two subsegments `a` and `b` of segments that share an end, each of
+/// whose middles would remove the other (segments at a sharp corner): both at the same
+/// distance from that corner, the middle of the distances both span (Ruppert's
+/// concentric shells), so that neither split point encroaches upon the other's pieces.
+/// Perturbation indices `pert` and `pert + 1`. `None`, with nothing changed, if the
+/// segments share no end, the subsegments span no common distance from it, or the CDT
+/// does not then have all four pieces as edges.
+fn split_pair(
+    cdt: &mut Cdt,
+    a: (VertexId, VertexId),
+    b: (VertexId, VertexId),
+    segs: &mut Segs<'_>,
+    prep: &PreparedPlc,
+    seg_index: &FxHashMap<(u32, u32), usize>,
+    pert: u32,
+) -> Result<Option<InPlaceSplit>, MeshError> {
+    let (Some(&sa), Some(&sb)) = (segs.seg_of.get(&a), segs.seg_of.get(&b)) else {
+        return Ok(None);
+    };
+    let ends = |g: usize| {
+        let chain = &segs.subsegs.chains[g];
+        (chain[0], *chain.last().unwrap_or(&chain[0]))
+    };
+    let ((a0, a1), (b0, b1)) = (ends(sa), ends(sb));
+    let Some(c) = [a0, a1]
+        .into_iter()
+        .find(|&x| sa != sb && (x == b0 || x == b1))
+    else {
+        if debug() {
+            eprintln!("pair {a:?} {b:?}: no common end ({a0},{a1}) ({b0},{b1})");
+        }
+        return Ok(None);
+    };
+    let pt = |x: VertexId| cdt.dt.points[x as usize];
+    let dist = |x: Point, y: Point| (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
+    let span = |e: (VertexId, VertexId)| {
+        let (x, y) = (dist(pt(c), pt(e.0)), dist(pt(c), pt(e.1)));
+        (x.min(y), x.max(y))
+    };
+    let (lo, hi) = {
+        let ((la, ha), (lb, hb)) = (span(a), span(b));
+        (la.max(lb), ha.min(hb))
+    };
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
+        if debug() {
+            eprintln!("pair {a:?} {b:?}: no common span {lo} {hi}");
+        }
+        return Ok(None);
+    }
+    let r = 0.5 * (lo + hi);
+    // Each split point's parameter along its segment, and the point.
+    let mut at_r = Vec::with_capacity(2);
+    for (e, seg) in [(a, sa), (b, sb)] {
+        let (e0, e1) = ends(seg);
+        let (pa, pb) = (pt(e0), pt(e1));
+        let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
+        let len = dist(pa, pb);
+        let s = if c == e0 { r / len } else { 1.0 - r / len };
+        let m: Point = std::array::from_fn(|k| pa[k] + d[k] * s);
+        let t = |x: VertexId| (0..3).map(|k| (pt(x)[k] - pa[k]) * d[k]).sum::<f64>() / (len * len);
+        let (t0, t1) = (t(e.0).min(t(e.1)), t(e.0).max(t(e.1)));
+        if !(t0 < s && s < t1) || m == pt(e.0) || m == pt(e.1) {
+            return Ok(None);
+        }
+        at_r.push((e, seg, s, m));
+    }
+    let through = facets_through(segs, prep, seg_index, &[sa, sb]);
+    let removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
+    let markers = [a, b].map(|e| segs.markers.remove(&e).unwrap_or(0));
+    for e in [a, b] {
+        cdt.subsegs.remove(&e);
+    }
+    let at = free::subsegment_ends(cdt);
+    let mut done: Vec<free::Inserted> = Vec::new();
+    for (k, &(_, _, _, m)) in at_r.iter().enumerate() {
+        match free::insert_point(cdt, m, pert + k as u32, &at, false)? {
+            ins @ free::Inserted::Yes { .. } => done.push(ins),
+            _ => break,
+        }
+    }
+    let vertex = |i: &free::Inserted| match i {
+        free::Inserted::Yes { vertex, .. } => Some(*vertex),
+        _ => None,
+    };
+    let ws: Vec<VertexId> = done.iter().filter_map(vertex).collect();
+    let pieces_in = ws.len() == 2
+        && at_r
+            .iter()
+            .zip(&ws)
+            .all(|(&(e, ..), &w)| cdt.has_edge(e.0, w) && cdt.has_edge(w, e.1));
+    if !pieces_in {
+        if debug() {
+            eprintln!("pair {a:?} {b:?}: in {}, pieces missing", ws.len());
+        }
+        for ins in done.into_iter().rev() {
+            free::take_back(cdt, ins);
+        }
+        cdt.subfaces.extend(removed);
+        for (e, marker) in [a, b].into_iter().zip(markers) {
+            segs.markers.insert(e, marker);
+            cdt.subsegs.insert(e, marker);
+        }
+        return Ok(None);
+    }
+    let mut splits = Vec::with_capacity(2);
+    for ((e, seg, s, m), (&w, marker)) in at_r.into_iter().zip(ws.iter().zip(markers)) {
+        if debug() {
+            let (u, v) = e;
+            eprintln!("split subsegment {u}-{v} in place at {m:?}, paired on a shell");
+        }
+        let chain = &mut segs.subsegs.chains[seg];
+        if let Some(i) = chain.windows(2).position(|x| edge_key(x[0], x[1]) == e) {
+            chain.insert(i + 1, w);
+        }
+        segs.subsegs.steiner_points += 1;
+        segs.seg_of.remove(&e);
+        for piece in [edge_key(e.0, w), edge_key(w, e.1)] {
+            segs.seg_of.insert(piece, seg);
+            segs.markers.insert(piece, marker);
+            cdt.subsegs.insert(piece, marker);
+        }
+        splits.push((seg, s));
+    }
+    Ok(Some((through, splits)))
 }
 
 /// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.
