@@ -26,7 +26,8 @@ use std::cmp::Ordering;
 pub struct Approx {
     /// The value, rounded.
     pub v: f64,
-    /// The permanent, rounded.
+    /// The permanent, rounded; for a value rounded from its exact expansion, its error
+    /// bound divided by `ERR`.
     pub p: f64,
 }
 
