@@ -67,7 +67,7 @@ impl MeshOut {
         for (n, &i) in kept.iter().enumerate() {
             new_index[i] = n as u32;
         }
-        let map = |v: &u32| new_index[*v as usize];
+        let map = |v: u32| new_index[v as usize];
         let k = self.num_point_attrs;
         Some(MeshOut {
             points: kept.iter().map(|&i| self.points[i]).collect(),
@@ -83,17 +83,17 @@ impl MeshOut {
                     .map(|&i| m.get(i).copied().unwrap_or(0))
                     .collect()
             }),
-            tets: self.tets.iter().map(|t| t.map(|v| map(&v))).collect(),
-            hull_faces: self.hull_faces.iter().map(|f| f.map(|v| map(&v))).collect(),
+            tets: self.tets.iter().map(|t| t.map(map)).collect(),
+            hull_faces: self.hull_faces.iter().map(|f| f.map(map)).collect(),
             subfaces: self
                 .subfaces
                 .iter()
-                .map(|(f, m)| (f.map(|v| map(&v)), *m))
+                .map(|(f, m)| (f.map(map), *m))
                 .collect(),
             subsegments: self
                 .subsegments
                 .iter()
-                .map(|(e, m)| (e.map(|v| map(&v)), *m))
+                .map(|(e, m)| (e.map(map), *m))
                 .collect(),
             neighbors: self.neighbors.clone(),
             tet_attrs: self.tet_attrs.clone(),

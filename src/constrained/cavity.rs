@@ -117,7 +117,7 @@ pub fn insert_region(
                 }
             }
             if added {
-                if std::env::var_os("TETCDT_DEBUG").is_some() {
+                if super::debug() {
                     eprintln!(
                         "facet {facet}: cavity widened over another triangulation of the region"
                     );

@@ -308,7 +308,7 @@ pub fn insert_region(
     let stuck_near = std::mem::take(&mut fl.stuck_near);
     let journal = fl.journal.take();
     drop(fl);
-    if debug() {
+    if super::debug() {
         eprintln!(
             "facet {facet}: {} crossing tets, {} flips, problem {problem:?}, {} exact compares",
             crossing.len(),
@@ -341,7 +341,7 @@ pub fn insert_region(
                 counts.not_flat_stuck += 1;
                 counts.not_flat_cavity_points += 1;
             }
-            if debug() {
+            if super::debug() {
                 let how = match outcome {
                     Outcome::Inserted(_) => "inserted by cavities",
                     _ => "the cavity code asks for a point",
@@ -361,7 +361,7 @@ pub fn insert_region(
             counts.not_flat_stuck += 1;
             *cdt.flips_stuck.entry(facet).or_insert(0) += 1;
             let near = nearest_triangle(tris, &stuck_near).unwrap_or(tris[0]);
-            if debug() {
+            if super::debug() {
                 eprintln!("facet {facet}: stuck, polygon not flat: flips taken back, Steiner point near {near:?}");
             }
             return Ok(Outcome::NeedsSteiner(steiner_point(
@@ -378,7 +378,7 @@ pub fn insert_region(
         Some(p) => {
             // A flat polygon: with exact flip times this should not happen.
             counts.fallbacks += 1;
-            if debug() {
+            if super::debug() {
                 eprintln!("facet {facet}: flips fall back to the cavity code ({p:?})");
             }
             let mut lost = lost_subfaces(cdt, &mut at_risk);
@@ -410,11 +410,6 @@ fn nearest_triangle(tris: &[[VertexId; 3]], near: &[VertexId]) -> Option<[Vertex
     tris.iter()
         .max_by_key(|t| t.iter().filter(|x| near.contains(x)).count())
         .copied()
-}
-
-/// Whether to trace fallbacks on stderr (`TETCDT_DEBUG=1`).
-fn debug() -> bool {
-    std::env::var_os("TETCDT_DEBUG").is_some()
 }
 
 /// Removes the subfaces among `at_risk` that are no longer mesh faces; their facets.
@@ -805,7 +800,7 @@ impl<'a> Flipper<'a> {
                     .copied()
                     .collect();
             }
-            if debug() {
+            if super::debug() {
                 eprintln!(
                     "stuck: {} tets in R, {} crossing, {} deferred flips",
                     r.len(),

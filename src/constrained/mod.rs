@@ -194,7 +194,8 @@ pub struct PlcMesh {
     pub warnings: Vec<String>,
 }
 
-/// Whether to trace restarts and Steiner points on stderr (`TETCDT_DEBUG=1`).
+/// Whether to trace restarts, Steiner points, cavity widening and flip fallbacks on
+/// stderr (`TETCDT_DEBUG=1`).
 fn debug() -> bool {
     std::env::var_os("TETCDT_DEBUG").is_some()
 }
@@ -1498,6 +1499,43 @@ struct Segs<'a> {
     facets_of: &'a mut Option<Vec<Vec<usize>>>,
 }
 
+impl Segs<'_> {
+    /// Takes subsegment `e` out of the constraints, so that a point may go in on it; its
+    /// marker, to put it back with ([`Segs::put_back`]) or to give its pieces.
+    fn take_out(&mut self, cdt: &mut Cdt, e: (VertexId, VertexId)) -> i32 {
+        cdt.subsegs.remove(&e);
+        self.markers.remove(&e).unwrap_or(0)
+    }
+
+    /// Puts subsegment `e` back among the constraints, with its marker.
+    fn put_back(&mut self, cdt: &mut Cdt, e: (VertexId, VertexId), marker: i32) {
+        self.markers.insert(e, marker);
+        cdt.subsegs.insert(e, marker);
+    }
+
+    /// Records vertex `w`, put in on subsegment `e` (taken out) of segment `seg`, as
+    /// splitting it: its two pieces take its place in the chain and the constraints.
+    fn record_split(
+        &mut self,
+        cdt: &mut Cdt,
+        seg: usize,
+        e: (VertexId, VertexId),
+        w: VertexId,
+        marker: i32,
+    ) {
+        let chain = &mut self.subsegs.chains[seg];
+        if let Some(i) = chain.windows(2).position(|x| edge_key(x[0], x[1]) == e) {
+            chain.insert(i + 1, w);
+        }
+        self.subsegs.steiner_points += 1;
+        self.seg_of.remove(&e);
+        for piece in [edge_key(e.0, w), edge_key(w, e.1)] {
+            self.seg_of.insert(piece, seg);
+            self.put_back(cdt, piece, marker);
+        }
+    }
+}
+
 /// Splits, in place, the subsegment that point `p` (a refused Steiner point on a
 /// polygon) would remove (`lost`, when known) or else encroaches upon most closely, at
 /// its middle (perturbation index `pert`).
@@ -1539,8 +1577,7 @@ fn split_encroached(
     let seg = segs.seg_of[&(u, v)];
     let chain = &segs.subsegs.chains[seg];
     let s = midpoint_parameter(cdt, chain, u, v);
-    let (pa, pb) = (pt(chain[0]), pt(*chain.last().unwrap_or(&chain[0])));
-    let m: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
+    let m = point_at(cdt, chain, s);
     if m == pt(u) || m == pt(v) {
         return Ok(None);
     }
@@ -1548,14 +1585,12 @@ fn split_encroached(
     // The facets through the subsegment are unrecovered: their subfaces would wall the
     // split point's cavity in on both sides. Kept to be put back if it is refused.
     let removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
-    let marker = segs.markers.remove(&(u, v)).unwrap_or(0);
-    cdt.subsegs.remove(&(u, v));
+    let marker = segs.take_out(cdt, (u, v));
     let at = free::subsegment_ends(cdt);
     let inserted = free::insert_point(cdt, m, pert, &at, false)?;
     let free::Inserted::Yes { vertex: w, .. } = inserted else {
         cdt.subfaces.extend(removed);
-        segs.markers.insert((u, v), marker);
-        cdt.subsegs.insert((u, v), marker);
+        segs.put_back(cdt, (u, v), marker);
         let free::Inserted::Refused { lost: Some(e), .. } = inserted else {
             return Ok(None);
         };
@@ -1574,20 +1609,7 @@ fn split_encroached(
     if debug() {
         eprintln!("split subsegment {u}-{v} in place at {m:?}: facets {through:?} again");
     }
-    let chain = &mut segs.subsegs.chains[seg];
-    if let Some(i) = chain
-        .windows(2)
-        .position(|x| edge_key(x[0], x[1]) == (u, v))
-    {
-        chain.insert(i + 1, w);
-    }
-    segs.subsegs.steiner_points += 1;
-    segs.seg_of.remove(&(u, v));
-    for e in [edge_key(u, w), edge_key(w, v)] {
-        segs.seg_of.insert(e, seg);
-        segs.markers.insert(e, marker);
-        cdt.subsegs.insert(e, marker);
-    }
+    segs.record_split(cdt, seg, (u, v), w, marker);
     Ok(Some((through, vec![(seg, s)])))
 }
 
@@ -1670,87 +1692,80 @@ fn split_pair(
     // Each split point's parameter along its segment, and the point.
     let mut at_r = Vec::with_capacity(2);
     for (e, seg) in [(a, sa), (b, sb)] {
+        let chain = &segs.subsegs.chains[seg];
         let (e0, e1) = ends(seg);
-        let (pa, pb) = (pt(e0), pt(e1));
-        let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
-        let len = dist(pa, pb);
+        let len = dist(pt(e0), pt(e1));
         let s = if c == e0 { r / len } else { 1.0 - r / len };
-        let m: Point = std::array::from_fn(|k| pa[k] + d[k] * s);
-        let t = |x: VertexId| (0..3).map(|k| (pt(x)[k] - pa[k]) * d[k]).sum::<f64>() / (len * len);
-        let (t0, t1) = (t(e.0).min(t(e.1)), t(e.0).max(t(e.1)));
-        if !(t0 < s && s < t1) || m == pt(e.0) || m == pt(e.1) {
+        let m = point_at(cdt, chain, s);
+        let (t0, t1) = (parameter(cdt, chain, e.0), parameter(cdt, chain, e.1));
+        if !(t0.min(t1) < s && s < t0.max(t1)) || m == pt(e.0) || m == pt(e.1) {
             return Ok(None);
         }
         at_r.push((e, seg, s, m));
     }
     let through = facets_through(segs, prep, seg_index, &[sa, sb]);
     let removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
-    let markers = [a, b].map(|e| segs.markers.remove(&e).unwrap_or(0));
-    for e in [a, b] {
-        cdt.subsegs.remove(&e);
-    }
+    let markers = [a, b].map(|e| segs.take_out(cdt, e));
     let at = free::subsegment_ends(cdt);
-    let mut done: Vec<free::Inserted> = Vec::new();
-    for (k, &(_, _, _, m)) in at_r.iter().enumerate() {
-        match free::insert_point(cdt, m, pert + k as u32, &at, false)? {
-            ins @ free::Inserted::Yes { .. } => done.push(ins),
-            _ => break,
-        }
+    // Both points go in, or neither: each would remove the other's subsegment alone.
+    let mut done: Vec<(VertexId, free::Inserted)> = Vec::with_capacity(2);
+    for (k, &(.., m)) in at_r.iter().enumerate() {
+        let inserted = free::insert_point(cdt, m, pert + k as u32, &at, false)?;
+        let free::Inserted::Yes { vertex, .. } = inserted else {
+            break;
+        };
+        done.push((vertex, inserted));
     }
-    let vertex = |i: &free::Inserted| match i {
-        free::Inserted::Yes { vertex, .. } => Some(*vertex),
-        _ => None,
-    };
-    let ws: Vec<VertexId> = done.iter().filter_map(vertex).collect();
-    let pieces_in = ws.len() == 2
+    let pieces_in = done.len() == 2
         && at_r
             .iter()
-            .zip(&ws)
-            .all(|(&(e, ..), &w)| cdt.has_edge(e.0, w) && cdt.has_edge(w, e.1));
+            .zip(&done)
+            .all(|(&(e, ..), &(w, _))| cdt.has_edge(e.0, w) && cdt.has_edge(w, e.1));
     if !pieces_in {
         if debug() {
-            eprintln!("pair {a:?} {b:?}: in {}, pieces missing", ws.len());
+            eprintln!("pair {a:?} {b:?}: in {}, pieces missing", done.len());
         }
-        for ins in done.into_iter().rev() {
-            free::take_back(cdt, ins);
+        for (_, inserted) in done.into_iter().rev() {
+            free::take_back(cdt, inserted);
         }
         cdt.subfaces.extend(removed);
         for (e, marker) in [a, b].into_iter().zip(markers) {
-            segs.markers.insert(e, marker);
-            cdt.subsegs.insert(e, marker);
+            segs.put_back(cdt, e, marker);
         }
         return Ok(None);
     }
     let mut splits = Vec::with_capacity(2);
-    for ((e, seg, s, m), (&w, marker)) in at_r.into_iter().zip(ws.iter().zip(markers)) {
+    for ((e, seg, s, m), ((w, _), marker)) in at_r.into_iter().zip(done.into_iter().zip(markers)) {
         if debug() {
             let (u, v) = e;
             eprintln!("split subsegment {u}-{v} in place at {m:?}, paired on a shell");
         }
-        let chain = &mut segs.subsegs.chains[seg];
-        if let Some(i) = chain.windows(2).position(|x| edge_key(x[0], x[1]) == e) {
-            chain.insert(i + 1, w);
-        }
-        segs.subsegs.steiner_points += 1;
-        segs.seg_of.remove(&e);
-        for piece in [edge_key(e.0, w), edge_key(w, e.1)] {
-            segs.seg_of.insert(piece, seg);
-            segs.markers.insert(piece, marker);
-            cdt.subsegs.insert(piece, marker);
-        }
+        segs.record_split(cdt, seg, e, w, marker);
         splits.push((seg, s));
     }
     Ok(Some((through, splits)))
 }
 
-/// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.
-fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -> f64 {
+/// The parameter of vertex `x` along the segment whose chain is `chain` (0 at its first
+/// end, 1 at its last), of its projection on the line through them.
+fn parameter(cdt: &Cdt, chain: &[VertexId], x: VertexId) -> f64 {
     let p = |x: VertexId| cdt.dt.points[x as usize];
     let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
     let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
     let den: f64 = (0..3).map(|k| d[k] * d[k]).sum();
-    let t = |x: VertexId| (0..3).map(|k| (p(x)[k] - pa[k]) * d[k]).sum::<f64>() / den;
-    0.5 * (t(u) + t(v))
+    (0..3).map(|k| (p(x)[k] - pa[k]) * d[k]).sum::<f64>() / den
+}
+
+/// The point at parameter `s` along the segment whose chain is `chain`.
+fn point_at(cdt: &Cdt, chain: &[VertexId], s: f64) -> Point {
+    let p = |x: VertexId| cdt.dt.points[x as usize];
+    let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
+    std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s)
+}
+
+/// The parameter along its segment (whose chain is `chain`) of the midpoint of `u`–`v`.
+fn midpoint_parameter(cdt: &Cdt, chain: &[VertexId], u: VertexId, v: VertexId) -> f64 {
+    0.5 * (parameter(cdt, chain, u) + parameter(cdt, chain, v))
 }
 
 /// Removes shim tets (four vertices on one facet) from the domain. A shim that carving
