@@ -653,23 +653,33 @@ fn free_points_go_into_the_cdt_without_a_restart() {
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/fandisk.off");
     let dir = tempfile::tempdir().unwrap();
     for (tag, flag) in [("c", "-pQ"), ("f", "-pQF")] {
-        let prefix = dir.path().join(tag);
-        let json = dir.path().join(format!("{tag}.json"));
-        let json_arg = json.to_str().unwrap();
-        let (code, err) = run(&m, &prefix, &[flag, "--check", "--stats-json", json_arg]);
-        assert_eq!(code, 0, "{tag}: {err}");
-        let stats = std::fs::read_to_string(&json).unwrap();
+        let stats = checked_stats(&m, dir.path(), tag, flag);
         assert!(
             json_number(&stats, "free_steiner_points") >= 1,
             "{tag}: {stats}"
         );
         assert_eq!(json_number(&stats, "restarts"), 0, "{tag}: {stats}");
-        if let Some(script) = validator() {
-            if let Err(report) = referee(&script, &m, &prefix, &[]) {
-                panic!("{tag}: {report}");
-            }
+    }
+}
+
+/// Meshes `model` with `switch`, `--check` and `--stats-json` (outputs in `dir`, named
+/// by `tag`); requires exit 0 and, where the referee is at hand, a mesh it accepts.
+/// The statistics, as JSON.
+fn checked_stats(model: &Path, dir: &Path, tag: &str, switch: &str) -> String {
+    let prefix = dir.join(tag);
+    let json = dir.join(format!("{tag}.json"));
+    let (code, err) = run(
+        model,
+        &prefix,
+        &[switch, "--check", "--stats-json", json.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{tag}: {err}");
+    if let Some(script) = validator() {
+        if let Err(report) = referee(&script, model, &prefix, &[]) {
+            panic!("{tag}: {report}");
         }
     }
+    std::fs::read_to_string(&json).unwrap()
 }
 
 #[test]
@@ -680,22 +690,9 @@ fn a_steiner_point_on_a_polygon_goes_into_the_cdt_without_a_restart() {
     // start again from the Delaunay stage.
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/hand.off");
     let dir = tempfile::tempdir().unwrap();
-    let prefix = dir.path().join("c");
-    let json = dir.path().join("c.json");
-    let (code, err) = run(
-        &m,
-        &prefix,
-        &["-pQ", "--check", "--stats-json", json.to_str().unwrap()],
-    );
-    assert_eq!(code, 0, "{err}");
-    let stats = std::fs::read_to_string(&json).unwrap();
+    let stats = checked_stats(&m, dir.path(), "c", "-pQ");
     assert_eq!(json_number(&stats, "facet_steiner_points"), 1, "{stats}");
     assert_eq!(json_number(&stats, "restarts"), 0, "{stats}");
-    if let Some(script) = validator() {
-        if let Err(report) = referee(&script, &m, &prefix, &[]) {
-            panic!("{report}");
-        }
-    }
 }
 
 #[test]
@@ -710,25 +707,16 @@ fn refused_steiner_points_split_subsegments_in_place_instead_of_restarting() {
     for (model, most_restarts) in [("rotor_small.off", 1), ("anchor.off", 1)] {
         let m = data.join(model);
         for (tag, flag) in [("c", "-pQ"), ("f", "-pQF")] {
-            let prefix = dir.path().join(format!("{model}-{tag}"));
-            let json = dir.path().join(format!("{model}-{tag}.json"));
-            let json_arg = json.to_str().unwrap();
-            let (code, err) = run(&m, &prefix, &[flag, "--check", "--stats-json", json_arg]);
-            assert_eq!(code, 0, "{model} {tag}: {err}");
-            let stats = std::fs::read_to_string(&json).unwrap();
+            let tag = format!("{model}-{tag}");
+            let stats = checked_stats(&m, dir.path(), &tag, flag);
             assert!(
                 json_number(&stats, "in_place_splits") >= 1,
-                "{model} {tag}: {stats}"
+                "{tag}: {stats}"
             );
             assert!(
                 json_number(&stats, "restarts") <= most_restarts,
-                "{model} {tag}: {stats}"
+                "{tag}: {stats}"
             );
-            if let Some(script) = validator() {
-                if let Err(report) = referee(&script, &m, &prefix, &[]) {
-                    panic!("{model} {tag}: {report}");
-                }
-            }
         }
     }
 }
@@ -743,22 +731,9 @@ fn a_cavity_the_region_does_not_split_widens_over_the_meshs_other_triangulation(
     // points on polygons instead of 4, 572 Steiner points instead of 579.
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/rotor_small.off");
     let dir = tempfile::tempdir().unwrap();
-    let prefix = dir.path().join("rotor_small");
-    let json = dir.path().join("rotor_small.json");
-    let (code, err) = run(
-        &m,
-        &prefix,
-        &["-pQ", "--check", "--stats-json", json.to_str().unwrap()],
-    );
-    assert_eq!(code, 0, "{err}");
-    let stats = std::fs::read_to_string(&json).unwrap();
+    let stats = checked_stats(&m, dir.path(), "rotor_small", "-pQ");
     assert!(json_number(&stats, "facet_steiner_points") <= 3, "{stats}");
     assert!(json_number(&stats, "steiner_points") <= 572, "{stats}");
-    if let Some(script) = validator() {
-        if let Err(report) = referee(&script, &m, &prefix, &[]) {
-            panic!("{report}");
-        }
-    }
 }
 
 #[test]
@@ -770,15 +745,7 @@ fn subsegments_at_a_sharp_corner_that_encroach_upon_each_other_split_in_place_to
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/fine_star.poly");
     let dir = tempfile::tempdir().unwrap();
     for sw in ["-pQ", "-pQF"] {
-        let prefix = dir.path().join("fine_star");
-        let json = dir.path().join("fine_star.json");
-        let (code, err) = run(
-            &m,
-            &prefix,
-            &[sw, "--check", "--stats-json", json.to_str().unwrap()],
-        );
-        assert_eq!(code, 0, "{err}");
-        let stats = std::fs::read_to_string(&json).unwrap();
+        let stats = checked_stats(&m, dir.path(), "fine_star", sw);
         assert_eq!(json_number(&stats, "restarts"), 0, "{sw} {stats}");
         assert_eq!(json_number(&stats, "in_place_splits"), 1, "{sw} {stats}");
         assert_eq!(
@@ -786,11 +753,6 @@ fn subsegments_at_a_sharp_corner_that_encroach_upon_each_other_split_in_place_to
             0,
             "{sw} {stats}"
         );
-        if let Some(script) = validator() {
-            if let Err(report) = referee(&script, &m, &prefix, &[]) {
-                panic!("{sw}: {report}");
-            }
-        }
     }
 }
 
