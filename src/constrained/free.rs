@@ -68,7 +68,8 @@ pub(super) enum Inserted {
         last: TetId,
     },
     /// It would break the CDT: nothing changed. With the subsegment it would remove, or
-    /// the subface its cavity would wrap around, when that is why.
+    /// the subface its cavity would wrap around (or that a flip it needs would remove),
+    /// when that is why.
     Refused {
         lost: Option<(VertexId, VertexId)>,
         wrapped: Option<[VertexId; 3]>,
@@ -81,7 +82,7 @@ pub(super) enum Inserted {
 /// subfaces, then flips until every face is locally Delaunay again. Refused, leaving
 /// the CDT as it was, if the flips cannot get there or a subsegment (`at`, from
 /// [`subsegment_ends`]) would be lost. `wrapped_asked`: whether a refusal should name the
-/// subface the cavity wraps around (a search over the cavity, wasted where nobody asks).
+/// subface in the way (a search, wasted where nobody asks).
 pub(super) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
@@ -122,11 +123,11 @@ pub(super) fn insert_point(
     };
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
-    let lost = if settled {
-        lost_subsegment(cdt, &changes, at)
-    } else {
-        None
+    let (lost, wrapped) = match settled {
+        Ok(()) => (lost_subsegment(cdt, &changes, at), None),
+        Err(in_way) => (None, in_way.filter(|_| wrapped_asked)),
     };
+    let settled = settled.is_ok();
     if settled && lost.is_none() {
         return Ok(Inserted::Yes {
             vertex,
@@ -145,10 +146,7 @@ pub(super) fn insert_point(
         );
     }
     cdt.dt.undo(vertex, &changes, last);
-    Ok(Inserted::Refused {
-        lost,
-        wrapped: None,
-    })
+    Ok(Inserted::Refused { lost, wrapped })
 }
 
 /// Takes back a point that [`insert_point`] put in, if nothing has changed since.
@@ -164,9 +162,13 @@ pub(super) fn take_back(cdt: &mut Cdt, inserted: Inserted) {
 }
 
 /// Flips the faces of the tets made so far (`changes`) that are not locally Delaunay
-/// until none is left, recording each flip; false if some face cannot be flipped (it
-/// would remove a subface or a subsegment, or the tets around it do not allow a flip).
-fn flip_to_delaunay(cdt: &mut Cdt, changes: &mut Vec<Change>) -> Result<bool, MeshError> {
+/// until none is left, recording each flip. Fails if some face cannot be flipped (it
+/// would remove a subface or a subsegment, or the tets around it do not allow a flip),
+/// naming a subface whose edge a wanted flip would remove, if there is one.
+fn flip_to_delaunay(
+    cdt: &mut Cdt,
+    changes: &mut Vec<Change>,
+) -> Result<Result<(), Option<[VertexId; 3]>>, MeshError> {
     let mut queue: Vec<FaceRef> = changes[0]
         .new
         .iter()
@@ -198,7 +200,7 @@ fn flip_to_delaunay(cdt: &mut Cdt, changes: &mut Vec<Change>) -> Result<bool, Me
         }
         flips += 1;
         if flips > MAX_FLIPS {
-            return Ok(false);
+            return Ok(Err(None));
         }
         let old: Vec<(TetId, crate::mesh::Tet)> =
             sh.old.iter().map(|&t| (t, *cdt.dt.mesh.tet(t))).collect();
@@ -213,7 +215,23 @@ fn flip_to_delaunay(cdt: &mut Cdt, changes: &mut Vec<Change>) -> Result<bool, Me
             new: made.to_vec(),
         });
     }
-    Ok(stuck.iter().all(|&f| !not_delaunay(cdt, f)))
+    let mut left = stuck
+        .into_iter()
+        .filter(|&f| not_delaunay(cdt, f))
+        .peekable();
+    if left.peek().is_none() {
+        return Ok(Ok(()));
+    }
+    // A subface in the way of a flip: unrecovering its facet may let the point in.
+    let in_way = left.find_map(|f| {
+        let sh = bistellar::shape(&cdt.dt.mesh, &cdt.dt.points, f)?;
+        let ([e0, e1], apices) = sh.edge.as_ref()?;
+        apices
+            .iter()
+            .map(|&x| face_key([*e0, *e1, x]))
+            .find(|k| cdt.subfaces.contains_key(k))
+    });
+    Ok(Err(in_way))
 }
 
 /// Is face `f` of a live real tet, between two real tets, not a subface, and not
