@@ -1406,7 +1406,8 @@ impl<'a> FacetContext<'a> {
 
 /// Inserts point `p` (perturbation index `pert`), on facet `fi`, into the CDT with the
 /// facet's subfaces taken out, so that they do not wall its cavity in, and those of up to
-/// [`MAX_UNRECOVERED`] more facets whose subfaces the cavity would wrap around. Its
+/// [`MAX_UNRECOVERED`] more facets whose subfaces are in its way (see
+/// [`insert_unrecovering`]). Its
 /// vertex and the facets taken out, to be triangulated and recovered again; or, with
 /// the subfaces put back, the subsegment it would remove, if that is why the CDT refuses
 /// it all the same. `at` as for [`free::insert_point`] (taking subfaces out leaves it).
@@ -1418,27 +1419,19 @@ fn insert_unrecovered(
     at: &crate::mesh::VertexLists<VertexId>,
 ) -> Result<Unrecovered, MeshError> {
     let mut facets = vec![fi];
-    let mut removed: Vec<([VertexId; 3], u32)> = Vec::new();
-    let outcome = loop {
-        let last = *facets.last().unwrap_or(&fi) as u32;
-        removed.extend(take_out_subfaces(cdt, |f| f == last));
-        match free::insert_point(cdt, p, pert, at, true)? {
-            free::Inserted::Yes { vertex, .. } => break Ok(vertex),
-            free::Inserted::Refused {
-                wrapped: Some(face),
-                ..
-            } => match cdt.subfaces.get(&face_key(face)) {
-                Some(&g) if facets.len() <= MAX_UNRECOVERED => facets.push(g as usize),
-                _ => break Err(None),
-            },
-            free::Inserted::Refused { lost, .. } => break Err(lost),
-            free::Inserted::OnVertex => break Err(None),
+    let mut removed = take_out_subfaces(cdt, |f| f as usize == fi);
+    let limit = 1 + MAX_UNRECOVERED;
+    let inserted = insert_unrecovering(cdt, (p, pert), at, (&mut facets, limit), &mut removed)?;
+    Ok(match inserted {
+        free::Inserted::Yes { vertex, .. } => Ok((vertex, facets)),
+        refused => {
+            cdt.subfaces.extend(removed);
+            Err(match refused {
+                free::Inserted::Refused { lost, .. } => lost,
+                _ => None,
+            })
         }
-    };
-    if outcome.is_err() {
-        cdt.subfaces.extend(removed);
-    }
-    Ok(outcome.map(|v| (v, facets)))
+    })
 }
 
 /// Takes the subfaces of the facets that `of` picks out of the CDT (unrecovering those
