@@ -1407,10 +1407,10 @@ impl<'a> FacetContext<'a> {
 /// Inserts point `p` (perturbation index `pert`), on facet `fi`, into the CDT with the
 /// facet's subfaces taken out, so that they do not wall its cavity in, and those of up to
 /// [`MAX_UNRECOVERED`] more facets whose subfaces are in its way (see
-/// [`insert_unrecovering`]). Its
-/// vertex and the facets taken out, to be triangulated and recovered again; or, with
-/// the subfaces put back, the subsegment it would remove, if that is why the CDT refuses
-/// it all the same. `at` as for [`free::insert_point`] (taking subfaces out leaves it).
+/// [`insert_unrecovering`]). Its vertex and the facets taken out, to be triangulated and
+/// recovered again; or, with the subfaces put back, the subsegment it would remove, if
+/// that is why the CDT refuses it all the same. `at` as for [`free::insert_point`]
+/// (taking subfaces out leaves it).
 fn insert_unrecovered(
     cdt: &mut Cdt,
     p: Point,
