@@ -936,14 +936,17 @@ fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetI
         for &t in &star {
             for i in 0..4 {
                 let f = mesh.face_verts(t, i);
-                if f.contains(&v)
+                let n = mesh.adj(FaceRef::new(t, i)).tet();
+                // Each face once: from its least vertex, and the lower of its two tets.
+                if f.iter().min() == Some(&v)
+                    && t < n
                     && f.iter().all(|x| region.verts.contains(x))
                     && !keys.contains(&face_key(f))
                 {
                     let c = [0, 1, 2].map(|k| (p(f[0])[k] + p(f[1])[k] + p(f[2])[k]) / 3.0);
                     if seen.inside_any(&cdt.dt.points, &region.tris, &c) {
                         out.push(t);
-                        out.push(mesh.adj(FaceRef::new(t, i)).tet());
+                        out.push(n);
                     }
                 }
             }

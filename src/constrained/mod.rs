@@ -1572,41 +1572,20 @@ fn split_encroached(
     let chain = &segs.subsegs.chains[seg];
     let s = midpoint_parameter(cdt, chain, u, v);
     let m = point_at(cdt, chain, s);
-    if m == pt(u) || m == pt(v) {
-        return Ok(None);
-    }
-    let mut through = facets_through(segs, prep, seg_index, &[seg]);
-    // The facets through the subsegment are unrecovered: their subfaces would wall the
-    // split point's cavity in on both sides. Kept to be put back if it is refused.
-    let mut removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
-    let marker = segs.take_out(cdt, (u, v));
-    let at = free::subsegment_ends(cdt);
-    let limit = through.len() + MAX_UNRECOVERED;
-    let inserted = insert_unrecovering(cdt, (m, pert), &at, (&mut through, limit), &mut removed)?;
-    let free::Inserted::Yes { vertex: w, .. } = inserted else {
-        cdt.subfaces.extend(removed);
-        segs.put_back(cdt, (u, v), marker);
-        let free::Inserted::Refused { lost: Some(e), .. } = inserted else {
-            return Ok(None);
-        };
-        if e == (u, v) || depth >= MAX_SPLIT_DEPTH {
-            return Ok(None);
-        }
-        // Two subsegments at a sharp corner encroach upon each other's middles: both
-        // are split at once, at one distance from the corner (with those their split
-        // points would remove).
-        if let Some(done) = split_group(cdt, (u, v), e, segs, prep, seg_index, pert)? {
-            return Ok(Some(done));
-        }
-        // A split point that would remove another subsegment splits that one instead,
-        // a few levels deep (a chain of encroachments, as in Ruppert's refinement).
-        return split_encroached(cdt, m, Some(e), segs, prep, seg_index, pert, depth + 1);
+    let e = match split_at(cdt, &[((u, v), seg, s)], segs, prep, seg_index, pert)? {
+        Ok(done) => return Ok(Some(done)),
+        Err(Some(e)) if e != (u, v) && depth < MAX_SPLIT_DEPTH => e,
+        Err(_) => return Ok(None),
     };
-    if debug() {
-        eprintln!("split subsegment {u}-{v} in place at {m:?}: facets {through:?} again");
+    // Two subsegments at a sharp corner encroach upon each other's middles: both are
+    // split at once, at one distance from the corner (with those their split points
+    // would remove).
+    if let Some(done) = split_group(cdt, (u, v), e, segs, prep, seg_index, pert)? {
+        return Ok(Some(done));
     }
-    segs.record_split(cdt, seg, (u, v), w, marker);
-    Ok(Some((through, vec![(seg, s)])))
+    // A split point that would remove another subsegment splits that one instead, a few
+    // levels deep (a chain of encroachments, as in Ruppert's refinement).
+    split_encroached(cdt, m, Some(e), segs, prep, seg_index, pert, depth + 1)
 }
 
 /// Inserts point `m` (perturbation index `pert`) with [`free::insert_point`]; where a
@@ -1686,10 +1665,7 @@ fn split_group(
     let (Some(&sa), Some(&sb)) = (segs.seg_of.get(&a), segs.seg_of.get(&b)) else {
         return Ok(None);
     };
-    let ends = |segs: &Segs<'_>, g: usize| {
-        let chain = &segs.subsegs.chains[g];
-        (chain[0], *chain.last().unwrap_or(&chain[0]))
-    };
+    let ends = |segs: &Segs<'_>, g: usize| chain_ends(&segs.subsegs.chains[g]);
     let ((a0, a1), (b0, b1)) = (ends(segs, sa), ends(segs, sb));
     let Some(c) = [a0, a1]
         .into_iter()
@@ -1721,7 +1697,7 @@ fn split_group(
     // The parameter along segment `g` at distance `r` from the corner.
     let on_shell = |cdt: &Cdt, segs: &Segs<'_>, g: usize| {
         let chain = &segs.subsegs.chains[g];
-        let len = parameter_length(cdt, chain);
+        let len = segment_length(cdt, chain);
         if chain[0] == c {
             r / len
         } else {
@@ -1756,16 +1732,26 @@ fn split_group(
     }
 }
 
+/// The first and last vertices of a segment's chain: its ends.
+fn chain_ends(chain: &[VertexId]) -> (VertexId, VertexId) {
+    (chain[0], *chain.last().unwrap_or(&chain[0]))
+}
+
 /// The length of the segment whose chain is `chain`.
-fn parameter_length(cdt: &Cdt, chain: &[VertexId]) -> f64 {
+fn segment_length(cdt: &Cdt, chain: &[VertexId]) -> f64 {
     let p = |x: VertexId| cdt.dt.points[x as usize];
-    let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
+    let (a, b) = chain_ends(chain);
+    let (pa, pb) = (p(a), p(b));
     (0..3).map(|k| (pb[k] - pa[k]).powi(2)).sum::<f64>().sqrt()
 }
 
 /// Splits the subsegments `cut` (each with its segment and the parameter along it of
-/// its split point), all of them or none (see [`split_group`]). When refused, with the
-/// subsegment a split point would remove, if that is why.
+/// its split point, with perturbation indices from `pert` on), all of them or none, in
+/// place: the facets through their segments are unrecovered, since their subfaces would
+/// wall the split points' cavities in on both sides (with those of facets whose subfaces
+/// are in the way), and returned to be triangulated and recovered again with the splits.
+/// When refused, nothing changed, with the subsegment a split point would remove if that
+/// is why.
 fn split_at(
     cdt: &mut Cdt,
     cut: &[((VertexId, VertexId), usize, f64)],
@@ -1839,7 +1825,7 @@ fn split_at(
     for ((e, seg, s, m), ((w, _), marker)) in at_r.into_iter().zip(done.into_iter().zip(markers)) {
         if debug() {
             let (u, v) = e;
-            eprintln!("split subsegment {u}-{v} in place at {m:?}, in a group of {n}");
+            eprintln!("split subsegment {u}-{v} in place at {m:?}, in a group of {n}: facets {through:?} again");
         }
         segs.record_split(cdt, seg, e, w, marker);
         splits.push((seg, s));
@@ -1857,7 +1843,8 @@ const MAX_GROUP: usize = 8;
 /// end, 1 at its last), of its projection on the line through them.
 fn parameter(cdt: &Cdt, chain: &[VertexId], x: VertexId) -> f64 {
     let p = |x: VertexId| cdt.dt.points[x as usize];
-    let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
+    let (a, b) = chain_ends(chain);
+    let (pa, pb) = (p(a), p(b));
     let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
     let den: f64 = (0..3).map(|k| d[k] * d[k]).sum();
     (0..3).map(|k| (p(x)[k] - pa[k]) * d[k]).sum::<f64>() / den
@@ -1866,7 +1853,8 @@ fn parameter(cdt: &Cdt, chain: &[VertexId], x: VertexId) -> f64 {
 /// The point at parameter `s` along the segment whose chain is `chain`.
 fn point_at(cdt: &Cdt, chain: &[VertexId], s: f64) -> Point {
     let p = |x: VertexId| cdt.dt.points[x as usize];
-    let (pa, pb) = (p(chain[0]), p(*chain.last().unwrap_or(&chain[0])));
+    let (a, b) = chain_ends(chain);
+    let (pa, pb) = (p(a), p(b));
     std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s)
 }
 
