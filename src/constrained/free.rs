@@ -109,7 +109,7 @@ pub(super) fn insert_point(
             let subfaces = &cdt.subfaces;
             let wrapped = wrapped_asked
                 .then(|| {
-                    cdt.dt.wrapped_face(|v: [VertexId; 4], f: usize| {
+                    cdt.dt.wrapped_face(&w, |v: [VertexId; 4], f: usize| {
                         let fv = FACE_VERTS[f];
                         subfaces.contains_key(&face_key([v[fv[0]], v[fv[1]], v[fv[2]]]))
                     })

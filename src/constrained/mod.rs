@@ -708,344 +708,427 @@ fn attempt(
     let mut retriangulate: Vec<usize> = Vec::new();
     let mut facets_of_seg: Option<Vec<Vec<usize>>> = None;
     stats.facet_steiner_points = 0;
-    while let Some(fi) = queue.pop() {
-        opts.check_cancel()?;
-        queued[fi] = false;
-        rounds += 1;
-        if rounds > max_rounds {
-            return Err(MeshError::Failed("facet recovery does not converge".into()).into());
-        }
-        if steiner_facets.contains(&fi) {
-            continue;
-        }
-        let f = &prep.facets[fi];
-        let tris = match &facet_tris[fi] {
-            Ok(Some(tris)) => tris,
-            Ok(None) => continue,
-            // The error is taken out to be returned.
-            Err(_) => {
-                std::mem::replace(&mut facet_tris[fi], Ok(None))?;
+    stats.free_steiner_points = 0;
+    // Free points whose cavities wrap around subfaces go in with those facets taken out,
+    // which are then recovered again: the facet recovery, the shims and the free points
+    // run again, pass after pass, on the one CDT (the free points' rounds, their search
+    // and its budget are counted over them all).
+    let mut passes = 0usize;
+    // What the flat-tet search needs, made once when first needed (free points leave
+    // the subsegments as they are, but facets recovered again may split some).
+    let mut search: Option<slivers::Search> = None;
+    // The perturbation indices of the free points put in with facets recovered again, and
+    // the points the first of them stood in for a restart with.
+    let mut free_in_place: Vec<u32> = Vec::new();
+    let mut restart_instead: Option<Vec<FacetPoint>> = None;
+    let mut free_rounds = 0usize;
+    let mut budget: Option<u64> = None;
+    let mut carved: Option<Carved>;
+    // The flat tets left on facets, when known (`None` after points went in).
+    let mut flat_left: Option<(usize, Option<u32>)>;
+    // The work of the construction before its free points (their search is bounded apart).
+    let mut facet_work;
+    'recover: loop {
+        passes += 1;
+        while let Some(fi) = queue.pop() {
+            opts.check_cancel()?;
+            queued[fi] = false;
+            rounds += 1;
+            if rounds > max_rounds {
+                return Err(MeshError::Failed("facet recovery does not converge".into()).into());
+            }
+            if steiner_facets.contains(&fi) {
                 continue;
             }
-        };
-        let mut missing = Vec::new();
-        for t in tris {
-            if cdt.has_face(t[0], t[1], t[2]) {
-                cdt.subfaces.insert(face_key(*t), fi as u32);
-            } else {
-                missing.push(*t);
-            }
-        }
-        let mut retriangulated = None;
-        for region in regions_of(&missing, &seg_markers) {
-            let fallbacks = stats.flips.fallbacks;
-            let outcome =
-                opts.inserter
-                    .insert(&mut cdt, &region, fi as u32, f.normal, &mut stats.flips)?;
-            if stats.flips.fallbacks > fallbacks {
-                stats.flip_fallback_facets.push(fi as u32);
-            }
-            match outcome {
-                Outcome::Inserted(rs) => {
-                    stats.regions += 1;
-                    stats.recovered_subfaces += rs.subfaces;
-                    stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);
-                    stats.crossing_tets += rs.crossing_tets;
-                    stats.max_region_crossing_tets =
-                        stats.max_region_crossing_tets.max(rs.crossing_tets);
-                    stats.enlarged_tets += rs.enlarged_tets;
-                    for lf in rs.lost {
-                        if let Some(q) = queued.get_mut(lf as usize).filter(|q| !**q) {
-                            *q = true;
-                            queue.push(lf as usize);
-                        }
-                    }
+            let f = &prep.facets[fi];
+            let tris = match &facet_tris[fi] {
+                Ok(Some(tris)) => tris,
+                Ok(None) => continue,
+                // The error is taken out to be returned.
+                Err(_) => {
+                    std::mem::replace(&mut facet_tris[fi], Ok(None))?;
+                    continue;
                 }
-                Outcome::NeedsSteiner(p) => {
-                    if debug() {
-                        eprintln!("facet {fi}: Steiner point {p:?}");
+            };
+            let mut missing = Vec::new();
+            for t in tris {
+                if cdt.has_face(t[0], t[1], t[2]) {
+                    cdt.subfaces.insert(face_key(*t), fi as u32);
+                } else {
+                    missing.push(*t);
+                }
+            }
+            let mut retriangulated = None;
+            for region in regions_of(&missing, &seg_markers) {
+                let fallbacks = stats.flips.fallbacks;
+                let outcome = opts.inserter.insert(
+                    &mut cdt,
+                    &region,
+                    fi as u32,
+                    f.normal,
+                    &mut stats.flips,
+                )?;
+                if stats.flips.fallbacks > fallbacks {
+                    stats.flip_fallback_facets.push(fi as u32);
+                }
+                match outcome {
+                    Outcome::Inserted(rs) => {
+                        stats.regions += 1;
+                        stats.recovered_subfaces += rs.subfaces;
+                        stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);
+                        stats.crossing_tets += rs.crossing_tets;
+                        stats.max_region_crossing_tets =
+                            stats.max_region_crossing_tets.max(rs.crossing_tets);
+                        stats.enlarged_tets += rs.enlarged_tets;
+                        for lf in rs.lost {
+                            if let Some(q) = queued.get_mut(lf as usize).filter(|q| !**q) {
+                                *q = true;
+                                queue.push(lf as usize);
+                            }
+                        }
                     }
-                    // The point goes straight into the CDT, and the facet is triangulated
-                    // again with it, if its triangles already in the mesh keep their
-                    // place; otherwise the construction starts again with it.
-                    let room = stats.steiner_points < opts.max_steiner
-                        && placed_on_facets < max_facet_points(plc);
-                    let asked = in_place_for.entry(p.map(f64::to_bits)).or_insert(0);
-                    // Updates are meant to be cheaper than a restart: not once this
-                    // construction has done a restart's worth of work.
-                    let update = !stats.in_place_off
-                        && in_place < MAX_IN_PLACE
-                        && *asked < MAX_IN_PLACE_EACH
-                        && stats.work + cdt.work.get() < RESTART_WORK / 4;
-                    *asked += 1;
-                    if room {
-                        let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
-                        let inserted = free::insert_point(&mut cdt, p, next_pert, at, false)?;
-                        // Refused, and for which subsegment if one would be lost.
-                        let refused = match &inserted {
-                            free::Inserted::Refused { lost, .. } => Some(*lost),
-                            _ => None,
-                        };
-                        if let free::Inserted::Yes { vertex, .. } = inserted {
-                            extra[fi].push(vertex);
-                            let ctx = FacetContext::new(
-                                plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra,
-                            );
-                            let again = ctx.triangles(fi);
-                            if let Ok(Some(new)) = &again {
-                                let keys: FxHashSet<[VertexId; 3]> =
-                                    new.iter().map(|t| face_key(*t)).collect();
-                                let kept = tris.iter().map(|t| face_key(*t)).all(|k| {
-                                    cdt.subfaces.get(&k) != Some(&(fi as u32)) || keys.contains(&k)
-                                });
-                                if kept {
-                                    retriangulated = Some(again);
-                                    next_pert += 1;
-                                    placed_on_facets += 1;
-                                    stats.steiner_points += 1;
-                                    stats.facet_steiner_points += 1;
-                                    queued[fi] = true;
-                                    queue.push(fi);
-                                    break;
-                                }
-                            }
-                            if debug() {
-                                eprintln!("facet {fi}: its triangles would move with the point");
-                            }
-                            extra[fi].pop();
-                            free::take_back(&mut cdt, inserted);
-                        } else if debug() {
-                            eprintln!("facet {fi}: the CDT refuses the point");
+                    Outcome::NeedsSteiner(p) => {
+                        if debug() {
+                            eprintln!("facet {fi}: Steiner point {p:?}");
                         }
-                        // A point refused for encroaching upon a subsegment: the
-                        // subsegment is split in place instead, and the facets through it
-                        // are triangulated and recovered again (the paper's update of a
-                        // CDT), which spares a whole construction. Failing that, the
-                        // point lies on the facet, whose own subfaces need not wall it
-                        // in: without them (and those it wraps around) it may go in, and
-                        // the facets are triangulated with it and recovered again.
-                        let mut segs = Segs {
-                            subsegs: &mut subsegs,
-                            seg_of: &mut seg_of,
-                            markers: &mut seg_markers,
-                            facets_of: &mut facets_of_seg,
-                        };
-                        let (mut split, mut unrecovered) = (None, None);
-                        if let (Some(lost), true) = (refused, update) {
-                            split = split_encroached(
-                                &mut cdt, p, lost, &mut segs, prep, &seg_index, next_pert, 0,
-                            )?;
-                            if split.is_none() {
-                                match insert_unrecovered(&mut cdt, p, fi, next_pert, at)? {
-                                    Ok(done) => unrecovered = Some(done),
-                                    // Then the subsegment it would remove is split.
-                                    Err(Some(lost)) => {
-                                        split = split_encroached(
-                                            &mut cdt,
-                                            p,
-                                            Some(lost),
-                                            &mut segs,
-                                            prep,
-                                            &seg_index,
-                                            next_pert,
-                                            0,
-                                        )?;
+                        // The point goes straight into the CDT, and the facet is triangulated
+                        // again with it, if its triangles already in the mesh keep their
+                        // place; otherwise the construction starts again with it.
+                        let room = stats.steiner_points < opts.max_steiner
+                            && placed_on_facets < max_facet_points(plc);
+                        let asked = in_place_for.entry(p.map(f64::to_bits)).or_insert(0);
+                        // Updates are meant to be cheaper than a restart: not once this
+                        // construction has done a restart's worth of work.
+                        let update = !stats.in_place_off
+                            && in_place < MAX_IN_PLACE
+                            && *asked < MAX_IN_PLACE_EACH
+                            && stats.work + cdt.work.get() < RESTART_WORK / 4;
+                        *asked += 1;
+                        if room {
+                            let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
+                            let inserted = free::insert_point(&mut cdt, p, next_pert, at, false)?;
+                            // Refused, and for which subsegment if one would be lost.
+                            let refused = match &inserted {
+                                free::Inserted::Refused { lost, .. } => Some(*lost),
+                                _ => None,
+                            };
+                            if let free::Inserted::Yes { vertex, .. } = inserted {
+                                extra[fi].push(vertex);
+                                let ctx = FacetContext::new(
+                                    plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra,
+                                );
+                                let again = ctx.triangles(fi);
+                                if let Ok(Some(new)) = &again {
+                                    let keys: FxHashSet<[VertexId; 3]> =
+                                        new.iter().map(|t| face_key(*t)).collect();
+                                    let kept = tris.iter().map(|t| face_key(*t)).all(|k| {
+                                        cdt.subfaces.get(&k) != Some(&(fi as u32))
+                                            || keys.contains(&k)
+                                    });
+                                    if kept {
+                                        retriangulated = Some(again);
+                                        next_pert += 1;
+                                        placed_on_facets += 1;
+                                        stats.steiner_points += 1;
+                                        stats.facet_steiner_points += 1;
+                                        queued[fi] = true;
+                                        queue.push(fi);
+                                        break;
                                     }
-                                    Err(None) => {}
                                 }
-                            }
-                        }
-                        let mut points = 1;
-                        let facets = match (split, unrecovered) {
-                            (Some((facets, at_splits)), _) => {
-                                points = at_splits.len() as u32;
-                                carried.0.extend(at_splits);
-                                Some(facets)
-                            }
-                            (None, Some((v, facets))) => {
-                                if debug() {
-                                    eprintln!("facet {fi}: in with facets {facets:?} unrecovered");
-                                }
-                                carried.1.push((fi, p));
-                                extra[fi].push(v);
-                                placed_on_facets += 1;
-                                stats.facet_steiner_points += 1;
-                                Some(facets)
-                            }
-                            (None, None) => {
                                 if debug() {
                                     eprintln!(
-                                        "facet {fi}: no update in place (allowed {update}, refused for {refused:?})"
+                                        "facet {fi}: its triangles would move with the point"
                                     );
                                 }
-                                None
+                                extra[fi].pop();
+                                free::take_back(&mut cdt, inserted);
+                            } else if debug() {
+                                eprintln!("facet {fi}: the CDT refuses the point");
                             }
-                        };
-                        if let Some(facets) = facets {
-                            ends = None;
-                            next_pert += points;
-                            stats.steiner_points += points as usize;
-                            stats.in_place_splits += 1;
-                            in_place += 1;
-                            if in_place == 1 {
-                                // Updates stand in for restarts, and are bounded as
-                                // they are, by the work done before the first one.
-                                let before = cdt.work.get();
-                                cdt.work_limit =
-                                    cdt.work_limit.min(before + restart_work_bound(before));
+                            // A point refused for encroaching upon a subsegment: the
+                            // subsegment is split in place instead, and the facets through it
+                            // are triangulated and recovered again (the paper's update of a
+                            // CDT), which spares a whole construction. Failing that, the
+                            // point lies on the facet, whose own subfaces need not wall it
+                            // in: without them (and those it wraps around) it may go in, and
+                            // the facets are triangulated with it and recovered again.
+                            let mut segs = Segs {
+                                subsegs: &mut subsegs,
+                                seg_of: &mut seg_of,
+                                markers: &mut seg_markers,
+                                facets_of: &mut facets_of_seg,
+                            };
+                            let (mut split, mut unrecovered) = (None, None);
+                            if let (Some(lost), true) = (refused, update) {
+                                split = split_encroached(
+                                    &mut cdt, p, lost, &mut segs, prep, &seg_index, next_pert, 0,
+                                )?;
+                                if split.is_none() {
+                                    match insert_unrecovered(&mut cdt, p, fi, next_pert, at)? {
+                                        Ok(done) => unrecovered = Some(done),
+                                        // Then the subsegment it would remove is split.
+                                        Err(Some(lost)) => {
+                                            split = split_encroached(
+                                                &mut cdt,
+                                                p,
+                                                Some(lost),
+                                                &mut segs,
+                                                prep,
+                                                &seg_index,
+                                                next_pert,
+                                                0,
+                                            )?;
+                                        }
+                                        Err(None) => {}
+                                    }
+                                }
                             }
-                            retriangulate.extend(facets);
-                            retriangulate.push(fi);
-                            break;
+                            let mut points = 1;
+                            let facets = match (split, unrecovered) {
+                                (Some((facets, at_splits)), _) => {
+                                    points = at_splits.len() as u32;
+                                    carried.0.extend(at_splits);
+                                    Some(facets)
+                                }
+                                (None, Some((v, facets))) => {
+                                    if debug() {
+                                        eprintln!(
+                                            "facet {fi}: in with facets {facets:?} unrecovered"
+                                        );
+                                    }
+                                    carried.1.push((fi, p));
+                                    extra[fi].push(v);
+                                    placed_on_facets += 1;
+                                    stats.facet_steiner_points += 1;
+                                    Some(facets)
+                                }
+                                (None, None) => {
+                                    if debug() {
+                                        eprintln!(
+                                        "facet {fi}: no update in place (allowed {update}, refused for {refused:?})"
+                                    );
+                                    }
+                                    None
+                                }
+                            };
+                            if let Some(facets) = facets {
+                                ends = None;
+                                next_pert += points;
+                                stats.steiner_points += points as usize;
+                                count_update(&mut cdt, &mut in_place, stats);
+                                retriangulate.extend(facets);
+                                retriangulate.push(fi);
+                                break;
+                            }
                         }
+                        steiner.push((fi, p));
+                        steiner_facets.insert(fi);
+                        break;
                     }
-                    steiner.push((fi, p));
-                    steiner_facets.insert(fi);
-                    break;
+                    Outcome::SplitSubsegment(u, v) => {
+                        if debug() {
+                            eprintln!("facet {fi}: split subsegment {u}-{v}");
+                        }
+                        let seg = seg_of[&edge_key(u, v)];
+                        splits.push((seg, midpoint_parameter(&cdt, &subsegs.chains[seg], u, v)));
+                        steiner_facets.insert(fi);
+                        break;
+                    }
                 }
-                Outcome::SplitSubsegment(u, v) => {
-                    if debug() {
-                        eprintln!("facet {fi}: split subsegment {u}-{v}");
+            }
+            if let Some(again) = retriangulated {
+                facet_tris[fi] = again;
+            }
+            if !retriangulate.is_empty() {
+                let ctx = FacetContext::new(plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra);
+                for g in retriangulate.drain(..) {
+                    facet_tris[g] = ctx.triangles(g);
+                    if !queued[g] {
+                        queued[g] = true;
+                        queue.push(g);
                     }
-                    let seg = seg_of[&edge_key(u, v)];
-                    splits.push((seg, midpoint_parameter(&cdt, &subsegs.chains[seg], u, v)));
-                    steiner_facets.insert(fi);
-                    break;
                 }
             }
         }
-        if let Some(again) = retriangulated {
-            facet_tris[fi] = again;
+        stats.facet_secs = t2.elapsed().as_secs_f64() - stats.surface_secs;
+        facet_work = cdt.work.get();
+        // The carving of the CDT as it stands, while nothing changes it.
+        carved = None;
+        if steiner.is_empty() && splits.is_empty() {
+            let (more, c) = resolve_shims(&mut cdt, plc, opts);
+            steiner.extend(more);
+            carved = c;
         }
-        if !retriangulate.is_empty() {
-            let ctx = FacetContext::new(plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra);
-            for g in retriangulate.drain(..) {
-                facet_tris[g] = ctx.triangles(g);
-                if !queued[g] {
-                    queued[g] = true;
-                    queue.push(g);
-                }
-            }
-        }
-    }
-    stats.facet_secs = t2.elapsed().as_secs_f64() - stats.surface_secs;
-    stats.work += cdt.work.get();
-    // The carving of the CDT as it stands, while nothing changes it.
-    let mut carved: Option<Carved> = None;
-    if steiner.is_empty() && splits.is_empty() {
-        let (more, c) = resolve_shims(&mut cdt, plc, opts);
-        steiner.extend(more);
-        carved = c;
-    }
 
-    stats.free_steiner_points = 0;
-    // What the flat-tet search needs, made once when first needed (free points leave
-    // the subsegments as they are).
-    let mut search: Option<slivers::Search> = None;
-    let make_search = |cdt: &Cdt| slivers::Search {
-        prep: merged,
-        input: &plc.points,
-        seg_ends: segment_ends(&subsegs, &cdt.dt.orig),
-        domain: slivers::Domain {
-            holes: &plc.holes,
-            regions: &plc.regions,
-            keep_hull: opts.keep_hull,
-        },
-        index: Default::default(),
-    };
-    // The flat tets left on facets, when known (`None` after points went in).
-    let mut flat_left: Option<(usize, Option<u32>)> = None;
-    if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
-        // Free points go straight into the CDT (`free.rs`), round after round; only if
-        // none of a round's can does the construction start again with them.
-        let search = search.get_or_insert_with(|| make_search(&cdt));
-        let mut stuck = Vec::new();
-        // The search tests candidate places against the slabs near them and walks to
-        // them; around a vertex far out of the model's scale the slabs' boxes grow and
-        // the walks get long, and it gives up past this much work.
-        let mut budget =
-            FREE_SEARCH_WORK_PER_SLOT * cdt.dt.mesh.num_slots() as u64 + FREE_SEARCH_WORK;
-        for _ in 0..MAX_FREE_ROUNDS {
-            let found = slivers::free_points(&mut cdt, search, &mut carved, &mut budget);
-            flat_left = Some(found.found);
-            let free = found.points;
-            stuck = found.stuck;
-            if debug() && !free.is_empty() {
-                eprintln!("free points {free:?}");
+        flat_left = None;
+        let mut recover_again = false;
+        if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
+            // Free points go straight into the CDT (`free.rs`), round after round; only if
+            // none of a round's can does the construction start again with them.
+            let search =
+                search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
+            if passes > 1 {
+                search.seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
             }
-            // They only improve a valid CDT: within -S, or not at all.
-            let room = opts
-                .max_steiner
-                .saturating_sub(stats.steiner_points + stats.free_steiner_points);
-            let free = &free[..free.len().min(room)];
-            if free.is_empty() {
+            let mut stuck = Vec::new();
+            // The search tests candidate places against the slabs near them and walks to
+            // them; around a vertex far out of the model's scale the slabs' boxes grow and
+            // the walks get long, and it gives up past this much work.
+            let budget = budget.get_or_insert_with(|| {
+                FREE_SEARCH_WORK_PER_SLOT * cdt.dt.mesh.num_slots() as u64 + FREE_SEARCH_WORK
+            });
+            while free_rounds < MAX_FREE_ROUNDS {
+                free_rounds += 1;
+                let found = slivers::free_points(&mut cdt, search, &mut carved, budget);
+                flat_left = Some(found.found);
+                let free = found.points;
+                stuck = found.stuck;
+                if debug() && !free.is_empty() {
+                    eprintln!("free points {free:?}");
+                }
+                // They only improve a valid CDT: within -S, or not at all.
+                let room = opts
+                    .max_steiner
+                    .saturating_sub(stats.steiner_points + stats.free_steiner_points);
+                let free = &free[..free.len().min(room)];
+                if free.is_empty() {
+                    break;
+                }
+                let (added, refused) =
+                    free::insert_free(&mut cdt, free, &mut next_pert, |cdt, v| {
+                        !search.on_facet_around(cdt, v)
+                    })?;
+                stats.free_steiner_points += added;
+                if added > 0 {
+                    carved = None;
+                    flat_left = None;
+                    continue;
+                }
+                // None fits into the CDT as it stands: the construction starts again with
+                // them, if that restart stays well within the bounds on restarts.
+                if debug() {
+                    eprintln!("free points refused by the CDT: {refused:?}");
+                }
+                // A point that an earlier attempt already had is not tried again.
+                let new: Vec<FacetPoint> = refused
+                    .iter()
+                    .filter(|p| !facet_points.iter().any(|(_, q)| q == *p))
+                    .map(|&p| (FREE_POINT, p))
+                    .collect();
+                // Rather than that, the refused points go in with the facets whose
+                // subfaces their cavities wrap around taken out, and those are recovered
+                // again. Only where the restart could still come: should a face around
+                // such a point cover a facet once those are recovered, it does.
+                let restart = stats.restarts < MAX_FREE_RESTARTS
+                    && stats.work + facet_work < RESTART_WORK / 4;
+                let update = restart
+                    && !new.is_empty()
+                    && !stats.in_place_off
+                    && in_place + refused.len() <= MAX_IN_PLACE;
+                if update {
+                    let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
+                    if let Some(facets) =
+                        insert_free_unrecovering(&mut cdt, &refused, next_pert, at)?
+                    {
+                        if debug() {
+                            eprintln!(
+                                "free points {refused:?}: in with facets {facets:?} unrecovered"
+                            );
+                        }
+                        for _ in &refused {
+                            free_in_place.push(next_pert);
+                            next_pert += 1;
+                            stats.free_steiner_points += 1;
+                            count_update(&mut cdt, &mut in_place, stats);
+                        }
+                        restart_instead.get_or_insert_with(|| new.clone());
+                        for g in facets {
+                            if !queued[g] {
+                                queued[g] = true;
+                                queue.push(g);
+                            }
+                        }
+                        recover_again = true;
+                        break;
+                    }
+                }
+                if restart {
+                    steiner.extend(new);
+                }
                 break;
             }
-            let (added, refused) = free::insert_free(&mut cdt, free, &mut next_pert, |cdt, v| {
-                !search.on_facet_around(cdt, v)
-            })?;
-            stats.free_steiner_points += added;
-            if added > 0 {
-                carved = None;
-                flat_left = None;
-                continue;
+            if recover_again {
+                continue 'recover;
             }
-            // None fits into the CDT as it stands: the construction starts again with
-            // them, if that restart stays well within the bounds on restarts.
-            if debug() {
-                eprintln!("free points refused by the CDT: {refused:?}");
-            }
-            // A point that an earlier attempt already had is not tried again.
-            let new = refused
-                .iter()
-                .filter(|p| !facet_points.iter().any(|(_, q)| q == *p))
-                .map(|&p| (FREE_POINT, p));
-            if stats.restarts < MAX_FREE_RESTARTS && stats.work < RESTART_WORK / 4 {
-                steiner.extend(new);
-            }
-            break;
-        }
-        if budget == 0 {
-            stats.free_searches_cut += 1;
-        }
-        stats.steiner_points += stats.free_steiner_points;
+            stats.steiner_points += stats.free_steiner_points;
 
-        // A flat tet whose circumsphere lies within its facet's slab spans a gap between
-        // segments closer than the slab is thick. Its size, not its shape, makes it flat:
-        // splitting its longest subsegment makes the tets there smaller against the gap.
-        // Like free points, they only improve a valid CDT: only while the restart they
-        // cost stays well within the bounds on restarts and their work.
-        let affordable = stats.restarts < MAX_FREE_RESTARTS
-            && stats.work < RESTART_WORK / 4
-            && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
-        if steiner.is_empty() && affordable {
-            splits.extend(flat_tet_splits(&cdt, &stuck, &seg_of, &subsegs));
-            if debug() && !splits.is_empty() {
-                eprintln!("flat tets {stuck:?}: splits {splits:?}");
+            // A flat tet whose circumsphere lies within its facet's slab spans a gap between
+            // segments closer than the slab is thick. Its size, not its shape, makes it flat:
+            // splitting its longest subsegment makes the tets there smaller against the gap.
+            // Like free points, they only improve a valid CDT: only while the restart they
+            // cost stays well within the bounds on restarts and their work.
+            let affordable = stats.restarts < MAX_FREE_RESTARTS
+                && stats.work + facet_work < RESTART_WORK / 4
+                && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
+            if steiner.is_empty() && affordable {
+                splits.extend(flat_tet_splits(&cdt, &stuck, &seg_of, &subsegs));
+                if debug() && !splits.is_empty() {
+                    eprintln!("flat tets {stuck:?}: splits {splits:?}");
+                }
             }
+        }
+        break;
+    }
+    stats.work += facet_work;
+    if budget == Some(0) {
+        stats.free_searches_cut += 1;
+    }
+    if steiner.is_empty() && splits.is_empty() && !free_in_place.is_empty() {
+        // A face around such a point that lies on a facet beside its triangles (in the
+        // slab of a facet far from flat) makes the construction start again instead, with
+        // the points as input vertices.
+        let search =
+            search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
+        let covering = (0..cdt.dt.points.len() as VertexId)
+            .filter(|&v| free_in_place.contains(&cdt.dt.orig[v as usize]))
+            .any(|v| search.covering_face_around(&cdt, v, false));
+        if covering {
+            if debug() {
+                eprintln!("free points put in with facets recovered again cover a facet: restart");
+            }
+            steiner.extend(restart_instead.take().into_iter().flatten());
         }
     }
     if !steiner.is_empty() || !splits.is_empty() {
         // What the updates in place put in goes into the next construction too, which
-        // would otherwise have to find it again.
+        // would otherwise have to find it again. Free points put in with facets recovered
+        // again stood in for a restart: the points it would have had go into this one.
         let (more_splits, more_points) = carried;
         splits.extend(more_splits);
         steiner.extend(more_points);
+        for p in restart_instead.into_iter().flatten() {
+            if !steiner.contains(&p) {
+                steiner.push(p);
+            }
+        }
         return Ok(Attempt::Restart(steiner, splits));
     }
     let (flat_left, retry_points) = match flat_left {
         // Known, and too many (or none) for other constructions: no search needed.
         Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.0) => (known, Vec::new()),
         _ => {
-            let search = search.get_or_insert_with(|| make_search(&cdt));
+            let search =
+                search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
             slivers::flat_left(&mut cdt, search, &mut carved, MAX_RETRY_TETS)
         }
     };
     let first_point_covers = match facet_points.first() {
         Some(&(FREE_POINT, _)) => {
             let v = inv.get(n_input).copied().filter(|&v| v != u32::MAX);
-            let search = search.get_or_insert_with(|| make_search(&cdt));
-            v.is_some_and(|v| search.covering_face_around(&cdt, v))
+            let search =
+                search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
+            v.is_some_and(|v| search.covering_face_around(&cdt, v, true))
         }
         _ => false,
     };
@@ -1057,6 +1140,27 @@ fn attempt(
         retry_points,
         first_point_covers,
     })))
+}
+
+/// What the search for flat tets on facets needs besides the CDT.
+fn flat_tet_search<'a>(
+    plc: &'a Plc,
+    merged: &'a PreparedPlc,
+    subsegs: &segments::Subsegments,
+    cdt: &Cdt,
+    opts: &PlcOptions,
+) -> slivers::Search<'a> {
+    slivers::Search {
+        prep: merged,
+        input: &plc.points,
+        seg_ends: segment_ends(subsegs, &cdt.dt.orig),
+        domain: slivers::Domain {
+            holes: &plc.holes,
+            regions: &plc.regions,
+            keep_hull: opts.keep_hull,
+        },
+        index: Default::default(),
+    }
 }
 
 /// The input ends of the segment of each Steiner point on one (`orig` maps vertices to
@@ -1434,10 +1538,59 @@ fn insert_unrecovered(
     })
 }
 
+/// Counts an update of the CDT in place of a restart. Updates stand in for restarts, and
+/// are bounded as they are, by the work done before the first one.
+fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
+    stats.in_place_splits += 1;
+    *in_place += 1;
+    if *in_place == 1 {
+        let before = cdt.work.get();
+        cdt.work_limit = cdt.work_limit.min(before + restart_work_bound(before));
+    }
+}
+
+/// Inserts free points `ps` (perturbation indices from `pert` on), refused by the CDT as
+/// it stands, each with the facets whose subfaces its cavity wraps around taken out (up
+/// to [`MAX_UNRECOVERED`] for each): all of them, and the facets to recover again, or
+/// none, with nothing changed (one left out would make the construction start again
+/// anyway).
+fn insert_free_unrecovering(
+    cdt: &mut Cdt,
+    ps: &[Point],
+    pert: u32,
+    at: &crate::mesh::VertexLists<VertexId>,
+) -> Result<Option<Vec<usize>>, MeshError> {
+    let mut done: Vec<(free::Inserted, TakenOut)> = Vec::new();
+    let mut facets = Vec::new();
+    for (k, &p) in ps.iter().enumerate() {
+        let (mut through, mut removed) = (Vec::new(), Vec::new());
+        let limit = MAX_UNRECOVERED;
+        let pk = (p, pert + k as u32);
+        let inserted = insert_unrecovering(cdt, pk, at, (&mut through, limit), &mut removed)?;
+        if !matches!(inserted, free::Inserted::Yes { .. }) {
+            // Taken back in the reverse order, each while it is the last change.
+            cdt.subfaces.extend(removed);
+            for (inserted, removed) in done.into_iter().rev() {
+                free::take_back(cdt, inserted);
+                cdt.subfaces.extend(removed);
+            }
+            return Ok(None);
+        }
+        done.push((inserted, removed));
+        facets.extend(through);
+    }
+    facets.sort_unstable();
+    facets.dedup();
+    Ok(Some(facets))
+}
+
+/// Subfaces taken out of the CDT with their facets, to be put back.
+type TakenOut = Vec<([VertexId; 3], u32)>;
+
 /// Takes the subfaces of the facets that `of` picks out of the CDT (unrecovering those
 /// facets), and returns them, to be put back with their facets.
-fn take_out_subfaces(cdt: &mut Cdt, of: impl Fn(u32) -> bool) -> Vec<([VertexId; 3], u32)> {
-    let out: Vec<([VertexId; 3], u32)> = cdt
+fn take_out_subfaces(cdt: &mut Cdt, of: impl Fn(u32) -> bool) -> TakenOut {
+    let out: TakenOut = cdt
         .subfaces
         .iter()
         .filter(|(_, &f)| of(f))
@@ -1597,7 +1750,7 @@ fn insert_unrecovering(
     (m, pert): (Point, u32),
     at: &crate::mesh::VertexLists<VertexId>,
     (through, limit): (&mut Vec<usize>, usize),
-    removed: &mut Vec<([VertexId; 3], u32)>,
+    removed: &mut TakenOut,
 ) -> Result<free::Inserted, MeshError> {
     loop {
         let inserted = free::insert_point(cdt, m, pert, at, true)?;

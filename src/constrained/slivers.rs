@@ -149,18 +149,18 @@ impl Search<'_> {
         best
     }
 
-    /// Whether the faces around vertex `v` that are not subfaces but have their three
-    /// vertices on one facet cover more than a trace of it (projected on the facet's
-    /// normal, together over a millionth of its area, the referee's tolerance): they
-    /// would lie on the facet beside its triangles.
-    pub(crate) fn covering_face_around(&self, cdt: &Cdt, v: VertexId) -> bool {
+    /// Whether the faces around vertex `v` (through it, or else opposite it in its tets)
+    /// that are not subfaces but have their three vertices on one facet cover more than a
+    /// trace of it (projected on the facet's normal, together over a millionth of its
+    /// area, the referee's tolerance): they would lie on the facet beside its triangles.
+    pub(crate) fn covering_face_around(&self, cdt: &Cdt, v: VertexId, through: bool) -> bool {
         let mut star = Vec::new();
         cdt.dt.star(v, &mut star);
         let mut covered: Vec<(u32, f64)> = Vec::new();
         for &t in star.iter().filter(|&&t| !cdt.is_ghost(t)) {
             for (i, &x) in cdt.dt.mesh.verts(t).iter().enumerate() {
-                // The faces through `v`: those opposite its other vertices.
-                if x == v || cdt.is_subface(t, i) {
+                // The faces through `v` are those opposite its other vertices.
+                if (x == v) == through || cdt.is_subface(t, i) {
                     continue;
                 }
                 let f = cdt.dt.mesh.face_verts(t, i);
@@ -171,9 +171,13 @@ impl Search<'_> {
                     continue;
                 };
                 let q = f.map(|x| cdt.dt.points[x as usize]);
+                if !self.face_inside_facet(fi as usize, &q) {
+                    continue;
+                }
                 let n = cross(&sub(&q[1], &q[0]), &sub(&q[2], &q[0]));
-                // Each face is seen from both its tets around `v`: halved.
-                let area = 0.25 * dot(&n, &slab.normal).abs();
+                // A face through `v` is seen from both its tets around `v`: halved.
+                let seen = if through { 0.25 } else { 0.5 };
+                let area = seen * dot(&n, &slab.normal).abs();
                 match covered.iter_mut().find(|(f, _)| *f == fi) {
                     Some((_, a)) => *a += area,
                     None => covered.push((fi, area)),
@@ -184,6 +188,45 @@ impl Search<'_> {
             self.slab(fi as usize)
                 .is_some_and(|s| a > 1e-6 * self.facet_area(fi as usize, &s.normal))
         })
+    }
+
+    /// Whether triangle `q`, near merged facet `fi`'s plane, lies inside its polygons, as
+    /// the referee asks: its centroid or a point halfway from it to a corner inside them,
+    /// seen along the facet's normal (even-odd over its rings, so not in a hole).
+    fn face_inside_facet(&self, fi: usize, q: &[Point; 3]) -> bool {
+        let f = &self.prep.facets[fi];
+        let ax = (0..3)
+            .max_by(|&a, &b| f.normal[a].abs().total_cmp(&f.normal[b].abs()))
+            .unwrap_or(2);
+        let (i, j) = ((ax + 1) % 3, (ax + 2) % 3);
+        let inside = |w: [f64; 2]| {
+            let mut odd = false;
+            for ring in &f.rings {
+                for (k, &x) in ring.iter().enumerate() {
+                    let a = self.input[x as usize];
+                    let b = self.input[ring[(k + 1) % ring.len()] as usize];
+                    if (a[j] > w[1]) != (b[j] > w[1])
+                        && w[0] < a[i] + (w[1] - a[j]) * (b[i] - a[i]) / (b[j] - a[j])
+                    {
+                        odd = !odd;
+                    }
+                }
+            }
+            odd
+        };
+        let at = |wt: [f64; 3]| {
+            let p = |c: usize| wt[0] * q[0][c] + wt[1] * q[1][c] + wt[2] * q[2][c];
+            [p(i), p(j)]
+        };
+        let third = 1.0 / 3.0;
+        [
+            [third, third, third],
+            [0.5, 0.25, 0.25],
+            [0.25, 0.5, 0.25],
+            [0.25, 0.25, 0.5],
+        ]
+        .into_iter()
+        .any(|wt| inside(at(wt)))
     }
 
     /// The area of merged facet `fi` projected on `normal`.
@@ -647,6 +690,68 @@ fn longest_edge2(p: &[Point; 4]) -> f64 {
 mod tests {
     use super::*;
     use crate::geom::lcg;
+
+    #[test]
+    fn a_face_covers_a_facet_only_inside_its_polygons() {
+        // An L-shaped facet in z = 0 (the notch is [1, 2] x [1, 2]), and a square one in
+        // z = 5 with a square hole in its middle.
+        let points: Vec<Point> = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ]
+        .iter()
+        .map(|&[x, y]| [x, y, 0.0])
+        .chain(
+            [[0.0, 0.0], [3.0, 0.0], [3.0, 3.0], [0.0, 3.0]]
+                .iter()
+                .chain(&[[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])
+                .map(|&[x, y]| [x, y, 5.0]),
+        )
+        .collect();
+        let plc = crate::plc::Plc {
+            points,
+            facets: vec![
+                crate::plc::Facet {
+                    polygons: vec![(0..6).collect()],
+                    ..Default::default()
+                },
+                crate::plc::Facet {
+                    polygons: vec![(6..10).collect(), (10..14).collect()],
+                    holes: vec![[1.5, 1.5, 5.0]],
+                    ..Default::default()
+                },
+            ],
+            ..Default::default()
+        };
+        let prep = super::super::prepare::prepare(&plc, true).unwrap();
+        let search = Search {
+            prep: &prep,
+            input: &plc.points,
+            seg_ends: FxHashMap::default(),
+            domain: Domain {
+                holes: &[],
+                regions: &[],
+                keep_hull: false,
+            },
+            index: Default::default(),
+        };
+        let tri = |x: f64, y: f64, z: f64| [[x, y, z], [x + 0.2, y, z], [x, y + 0.2, z]];
+        let facet = |z: f64| {
+            let f = prep.facets.iter().position(|f| plc.points[f.rings[0][0] as usize][2] == z);
+            f.unwrap()
+        };
+        let (l, holed) = (facet(0.0), facet(5.0));
+        assert!(search.face_inside_facet(l, &tri(0.2, 0.2, 0.0)));
+        assert!(search.face_inside_facet(l, &tri(0.2, 1.5, 1e-9)));
+        assert!(!search.face_inside_facet(l, &tri(1.5, 1.5, 0.0)));
+        assert!(search.face_inside_facet(holed, &tri(0.2, 0.2, 5.0)));
+        assert!(search.face_inside_facet(holed, &tri(2.5, 2.5, 5.0)));
+        assert!(!search.face_inside_facet(holed, &tri(1.4, 1.4, 5.0)));
+    }
 
     #[test]
     fn slab_tests_are_charged_to_the_search_budget() {

@@ -144,18 +144,37 @@ impl Delaunay {
         })
     }
 
-    /// After [`Delaunay::insert_walled`] refused a point, a blocked face that its cavity
-    /// reached from both sides, if that is why.
+    /// After [`Delaunay::insert_walled`] refused point `p`, a blocked face that its cavity
+    /// reached from both sides, or else one walling it in that `p` does not see from the
+    /// cavity's side (the cavity wraps around its edge), if that is why.
     pub fn wrapped_face(
         &self,
+        p: &Point,
         blocked: impl Fn([VertexId; 4], usize) -> bool,
     ) -> Option<[VertexId; 3]> {
         let inside: rustc_hash::FxHashSet<TetId> = self.conflict.iter().copied().collect();
-        self.conflict.iter().find_map(|&t| {
+        let both_sides = self.conflict.iter().find_map(|&t| {
             let tet = self.mesh.tet(t);
             (0..4)
                 .find(|&f| blocked(tet.v, f) && inside.contains(&tet.adj[f].tet()))
                 .map(|f| self.mesh.face_verts(t, f))
+        });
+        both_sides.or_else(|| {
+            self.conflict.iter().find_map(|&t| {
+                let tet = self.mesh.tet(t);
+                (0..4)
+                    .find(|&f| {
+                        let mut v = tet.v.map(|x| (x != GHOST).then(|| *self.pt(x)));
+                        v[f] = Some(*p);
+                        let [Some(a), Some(b), Some(c), Some(d)] = v else {
+                            return false;
+                        };
+                        blocked(tet.v, f)
+                            && !inside.contains(&tet.adj[f].tet())
+                            && self.filter.orient3d(&a, &b, &c, &d) <= 0.0
+                    })
+                    .map(|f| self.mesh.face_verts(t, f))
+            })
         })
     }
 
