@@ -791,6 +791,15 @@ fn a_refused_free_point_goes_in_with_the_facets_its_cavity_wraps_around_recovere
     }
 }
 
+#[test]
+fn a_group_of_more_than_eight_subsegments_at_a_sharp_corner_splits_in_place() {
+    // In fine_star_wide_group, the group split at a pole's fan grows past eight
+    // subsegments (the points on one shell would remove more of the fan's spokes): all
+    // are split in place at once, where groups of at most eight made the construction
+    // restart.
+    updated_in_place_without_restart("fine_star_wide_group.poly", 1);
+}
+
 fn updated_in_place_without_restart(model: &str, in_place: usize) -> Vec<(&'static str, String)> {
     let m = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("data/nonflat")

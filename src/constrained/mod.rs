@@ -1986,11 +1986,11 @@ fn split_at(
     Ok(Ok((through, splits)))
 }
 
-/// The most subsegments that [`split_group`] splits at once. Larger groups (all the
-/// spokes of a fine fan, split on one shell) left flat tets on fine folded surfaces
-/// after later restarts (124 on one of 80 small fine stars with 32) for a few restarts
-/// fewer (65 against 68 over those 80).
-const MAX_GROUP: usize = 8;
+/// The most subsegments that [`split_group`] splits at once. Groups of up to 16 spare a
+/// few restarts against 8 (64 against 68 over 120 small fine stars); larger ones (all
+/// the spokes of a fine fan, split on one shell) left flat tets on fine folded surfaces
+/// after later restarts (124 on one small fine star with 32).
+const MAX_GROUP: usize = 16;
 
 /// The parameter of vertex `x` along the segment whose chain is `chain` (0 at its first
 /// end, 1 at its last), of its projection on the line through them.
