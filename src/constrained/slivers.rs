@@ -741,7 +741,10 @@ mod tests {
         };
         let tri = |x: f64, y: f64, z: f64| [[x, y, z], [x + 0.2, y, z], [x, y + 0.2, z]];
         let facet = |z: f64| {
-            let f = prep.facets.iter().position(|f| plc.points[f.rings[0][0] as usize][2] == z);
+            let f = prep
+                .facets
+                .iter()
+                .position(|f| plc.points[f.rings[0][0] as usize][2] == z);
             f.unwrap()
         };
         let (l, holed) = (facet(0.0), facet(5.0));
