@@ -792,6 +792,21 @@ fn a_refused_free_point_goes_in_with_the_facets_its_cavity_wraps_around_recovere
 }
 
 #[test]
+fn a_free_point_that_would_remove_a_subsegment_gives_way_to_its_split_in_place() {
+    // In mpi.off, free points for flat tets on facets would remove subsegments (after
+    // the facets their cavities wrap around are taken out): the subsegments are split in
+    // place instead, the facets through them recovered again, and the next round's free
+    // points go in, where the construction used to restart with the refused points.
+    for (sw, stats) in updated_in_place_without_restart("mpi.off", 3) {
+        assert!(
+            json_number(&stats, "free_steiner_points") >= 1,
+            "{sw} {stats}"
+        );
+        assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{sw} {stats}");
+    }
+}
+
+#[test]
 fn a_group_of_more_than_eight_subsegments_at_a_sharp_corner_splits_in_place() {
     // In fine_star_wide_group, the group split at a pole's fan grows past eight
     // subsegments (the points on one shell would remove more of the fan's spokes): all

@@ -721,6 +721,8 @@ fn attempt(
     // the points the first of them stood in for a restart with.
     let mut free_in_place: Vec<u32> = Vec::new();
     let mut restart_instead: Option<Vec<FacetPoint>> = None;
+    // Whether refused free points have given way to subsegment splits.
+    let mut free_splits = false;
     let mut free_rounds = 0usize;
     let mut budget: Option<u64> = None;
     let mut carved: Option<Carved>;
@@ -942,13 +944,8 @@ fn attempt(
             }
             if !retriangulate.is_empty() {
                 let ctx = FacetContext::new(plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra);
-                for g in retriangulate.drain(..) {
-                    facet_tris[g] = ctx.triangles(g);
-                    if !queued[g] {
-                        queued[g] = true;
-                        queue.push(g);
-                    }
-                }
+                let queues = (&mut queue, &mut queued[..]);
+                triangulate_again(&ctx, retriangulate.drain(..), &mut facet_tris, queues);
             }
         }
         stats.facet_secs = t2.elapsed().as_secs_f64() - stats.surface_secs;
@@ -1028,28 +1025,80 @@ fn attempt(
                     && in_place + refused.len() <= MAX_IN_PLACE;
                 if update {
                     let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
-                    if let Some(facets) =
-                        insert_free_unrecovering(&mut cdt, &refused, next_pert, at)?
-                    {
-                        if debug() {
-                            eprintln!(
-                                "free points {refused:?}: in with facets {facets:?} unrecovered"
-                            );
+                    match insert_free_unrecovering(&mut cdt, &refused, next_pert, at)? {
+                        FreeInPlace::In(facets) => {
+                            if debug() {
+                                eprintln!(
+                                    "free points {refused:?}: in with facets {facets:?} unrecovered"
+                                );
+                            }
+                            for _ in &refused {
+                                free_in_place.push(next_pert);
+                                next_pert += 1;
+                                stats.free_steiner_points += 1;
+                                count_update(&mut cdt, &mut in_place, stats);
+                            }
+                            for g in facets {
+                                if !queued[g] {
+                                    queued[g] = true;
+                                    queue.push(g);
+                                }
+                            }
+                            recover_again = true;
                         }
-                        for _ in &refused {
-                            free_in_place.push(next_pert);
-                            next_pert += 1;
-                            stats.free_steiner_points += 1;
-                            count_update(&mut cdt, &mut in_place, stats);
-                        }
-                        restart_instead.get_or_insert_with(|| new.clone());
-                        for g in facets {
-                            if !queued[g] {
-                                queued[g] = true;
-                                queue.push(g);
+                        FreeInPlace::Encroaching(lost) if !free_splits => {
+                            // As in Ruppert's refinement, a free point that would remove a
+                            // subsegment gives way to a split of it (in place, with the
+                            // facets through it triangulated and recovered again); the
+                            // next round finds the flat tets' points anew. Once only: at
+                            // a corner whose flat tets' spheres lie in a slab (`mpi.off`)
+                            // the next points encroach again, closer to the corner each
+                            // time. Nor are these splits carried into a restart, which
+                            // is then the one they stood in for.
+                            free_splits = true;
+                            let mut segs = Segs {
+                                subsegs: &mut subsegs,
+                                seg_of: &mut seg_of,
+                                markers: &mut seg_markers,
+                                facets_of: &mut facets_of_seg,
+                            };
+                            let mut again = Vec::new();
+                            for (p, e) in lost {
+                                let split = split_encroached(
+                                    &mut cdt,
+                                    p,
+                                    Some(e),
+                                    &mut segs,
+                                    prep,
+                                    &seg_index,
+                                    next_pert,
+                                    0,
+                                )?;
+                                let Some((facets, at_splits)) = split else {
+                                    continue;
+                                };
+                                if debug() {
+                                    eprintln!("free point {p:?}: splits {at_splits:?} instead");
+                                }
+                                next_pert += at_splits.len() as u32;
+                                stats.steiner_points += at_splits.len();
+                                count_update(&mut cdt, &mut in_place, stats);
+                                again.extend(facets);
+                            }
+                            if !again.is_empty() {
+                                ends = None;
+                                let ctx = FacetContext::new(
+                                    plc, prep, &cdt.dt, &inv, &seg_index, &subsegs, &extra,
+                                );
+                                let queues = (&mut queue, &mut queued[..]);
+                                triangulate_again(&ctx, again, &mut facet_tris, queues);
+                                recover_again = true;
                             }
                         }
-                        recover_again = true;
+                        _ => {}
+                    }
+                    if recover_again {
+                        restart_instead.get_or_insert_with(|| new.clone());
                         break;
                     }
                 }
@@ -1538,6 +1587,23 @@ fn insert_unrecovered(
     })
 }
 
+/// Triangulates facets `gs` again (a subsegment on them was split) into `facet_tris`, and
+/// queues them for recovery.
+fn triangulate_again(
+    ctx: &FacetContext<'_>,
+    gs: impl IntoIterator<Item = usize>,
+    facet_tris: &mut [FacetTris],
+    (queue, queued): (&mut Vec<usize>, &mut [bool]),
+) {
+    for g in gs {
+        facet_tris[g] = ctx.triangles(g);
+        if !queued[g] {
+            queued[g] = true;
+            queue.push(g);
+        }
+    }
+}
+
 /// Counts an update of the CDT in place of a restart. Updates stand in for restarts, and
 /// are bounded as they are, by the work done before the first one.
 fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
@@ -1549,39 +1615,66 @@ fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
     }
 }
 
+/// What [`insert_free_unrecovering`] did with a round's refused free points.
+enum FreeInPlace {
+    /// All went in: the facets to recover again.
+    In(Vec<usize>),
+    /// Each went in or would remove a subsegment, and those that did go in were taken
+    /// back: the points that would, with their subsegments.
+    Encroaching(Vec<(Point, (VertexId, VertexId))>),
+    /// Some would do neither: nothing changed.
+    No,
+}
+
 /// Inserts free points `ps` (perturbation indices from `pert` on), refused by the CDT as
 /// it stands, each with the facets whose subfaces its cavity wraps around taken out (up
-/// to [`MAX_UNRECOVERED`] for each): all of them, and the facets to recover again, or
-/// none, with nothing changed (one left out would make the construction start again
-/// anyway).
+/// to [`MAX_UNRECOVERED`] for each): all of them, or none, with nothing changed (one left
+/// out would make the construction start again anyway), and then the subsegments that
+/// some would remove, if that is what kept them out.
 fn insert_free_unrecovering(
     cdt: &mut Cdt,
     ps: &[Point],
     pert: u32,
     at: &crate::mesh::VertexLists<VertexId>,
-) -> Result<Option<Vec<usize>>, MeshError> {
+) -> Result<FreeInPlace, MeshError> {
     let mut done: Vec<(free::Inserted, TakenOut)> = Vec::new();
     let mut facets = Vec::new();
+    let mut lost = Vec::new();
+    let mut left_out = false;
     for (k, &p) in ps.iter().enumerate() {
         let (mut through, mut removed) = (Vec::new(), Vec::new());
         let limit = MAX_UNRECOVERED;
         let pk = (p, pert + k as u32);
         let inserted = insert_unrecovering(cdt, pk, at, (&mut through, limit), &mut removed)?;
-        if !matches!(inserted, free::Inserted::Yes { .. }) {
-            // Taken back in the reverse order, each while it is the last change.
-            cdt.subfaces.extend(removed);
-            for (inserted, removed) in done.into_iter().rev() {
-                free::take_back(cdt, inserted);
-                cdt.subfaces.extend(removed);
+        match inserted {
+            free::Inserted::Yes { .. } => {
+                done.push((inserted, removed));
+                facets.extend(through);
+                continue;
             }
-            return Ok(None);
+            free::Inserted::Refused { lost: Some(e), .. } => lost.push((p, e)),
+            _ => left_out = true,
         }
-        done.push((inserted, removed));
-        facets.extend(through);
+        cdt.subfaces.extend(removed);
+        if left_out {
+            break;
+        }
     }
-    facets.sort_unstable();
-    facets.dedup();
-    Ok(Some(facets))
+    if lost.is_empty() && !left_out {
+        facets.sort_unstable();
+        facets.dedup();
+        return Ok(FreeInPlace::In(facets));
+    }
+    // Taken back in the reverse order, each while it is the last change.
+    for (inserted, removed) in done.into_iter().rev() {
+        free::take_back(cdt, inserted);
+        cdt.subfaces.extend(removed);
+    }
+    Ok(if left_out {
+        FreeInPlace::No
+    } else {
+        FreeInPlace::Encroaching(lost)
+    })
 }
 
 /// Subfaces taken out of the CDT with their facets, to be put back.
