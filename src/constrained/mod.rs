@@ -713,13 +713,14 @@ fn attempt(
     // which are then recovered again: the facet recovery, the shims and the free points
     // run again, pass after pass, on the one CDT (the free points' rounds, their search
     // and its budget are counted over them all).
-    let mut passes = 0usize;
     // What the flat-tet search needs, made once when first needed (free points leave
-    // the subsegments as they are, but facets recovered again may split some).
+    // the subsegments as they are, but facets recovered again may split some: then its
+    // record of them is made again), and the segment splits it knows of.
     let mut search: Option<slivers::Search> = None;
-    // The perturbation indices of the free points put in with facets recovered again, and
-    // the points the first of them stood in for a restart with.
-    let mut free_in_place: Vec<u32> = Vec::new();
+    let mut search_splits = 0usize;
+    // The free points put in with facets recovered again, and the points the first of
+    // them stood in for a restart with.
+    let mut free_in_place: Vec<VertexId> = Vec::new();
     let mut restart_instead: Option<Vec<FacetPoint>> = None;
     // Whether refused free points have given way to subsegment splits.
     let mut free_splits = false;
@@ -731,7 +732,6 @@ fn attempt(
     // The work of the construction before its free points (their search is bounded apart).
     let mut facet_work;
     'recover: loop {
-        passes += 1;
         while let Some(fi) = queue.pop() {
             opts.check_cancel()?;
             queued[fi] = false;
@@ -963,12 +963,18 @@ fn attempt(
         if steiner.is_empty() && splits.is_empty() && stats.restarts < MAX_FREE_ROUNDS {
             // Free points go straight into the CDT (`free.rs`), round after round; only if
             // none of a round's can does the construction start again with them.
-            let search =
-                search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
-            if passes > 1 {
+            let search = search.get_or_insert_with(|| {
+                search_splits = subsegs.steiner_points;
+                flat_tet_search(plc, merged, &subsegs, &cdt, opts)
+            });
+            if search_splits != subsegs.steiner_points {
+                search_splits = subsegs.steiner_points;
                 search.seg_ends = segment_ends(&subsegs, &cdt.dt.orig);
             }
             let mut stuck = Vec::new();
+            // Room for a restart (for free points or flat tets' splits) in this pass.
+            let restart_room =
+                stats.restarts < MAX_FREE_RESTARTS && stats.work + facet_work < RESTART_WORK / 4;
             // The search tests candidate places against the slabs near them and walks to
             // them; around a vertex far out of the model's scale the slabs' boxes grow and
             // the walks get long, and it gives up past this much work.
@@ -1017,32 +1023,27 @@ fn attempt(
                 // subfaces their cavities wrap around taken out, and those are recovered
                 // again. Only where the restart could still come: should a face around
                 // such a point cover a facet once those are recovered, it does.
-                let restart = stats.restarts < MAX_FREE_RESTARTS
-                    && stats.work + facet_work < RESTART_WORK / 4;
-                let update = restart
+                let update = restart_room
                     && !new.is_empty()
                     && !stats.in_place_off
                     && in_place + refused.len() <= MAX_IN_PLACE;
                 if update {
                     let at = ends.get_or_insert_with(|| free::subsegment_ends(&cdt));
                     match insert_free_unrecovering(&mut cdt, &refused, next_pert, at)? {
-                        FreeInPlace::In(facets) => {
+                        FreeInPlace::In(vertices, facets) => {
                             if debug() {
                                 eprintln!(
                                     "free points {refused:?}: in with facets {facets:?} unrecovered"
                                 );
                             }
-                            for _ in &refused {
-                                free_in_place.push(next_pert);
+                            for &v in &vertices {
+                                free_in_place.push(v);
                                 next_pert += 1;
                                 stats.free_steiner_points += 1;
                                 count_update(&mut cdt, &mut in_place, stats);
                             }
                             for g in facets {
-                                if !queued[g] {
-                                    queued[g] = true;
-                                    queue.push(g);
-                                }
+                                enqueue(&mut queue, &mut queued, g);
                             }
                             recover_again = true;
                         }
@@ -1102,7 +1103,7 @@ fn attempt(
                         break;
                     }
                 }
-                if restart {
+                if restart_room {
                     steiner.extend(new);
                 }
                 break;
@@ -1117,9 +1118,8 @@ fn attempt(
             // splitting its longest subsegment makes the tets there smaller against the gap.
             // Like free points, they only improve a valid CDT: only while the restart they
             // cost stays well within the bounds on restarts and their work.
-            let affordable = stats.restarts < MAX_FREE_RESTARTS
-                && stats.work + facet_work < RESTART_WORK / 4
-                && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
+            let affordable =
+                restart_room && 2 * (presplits.len() + stuck.len()) <= max_facet_points(plc);
             if steiner.is_empty() && affordable {
                 splits.extend(flat_tet_splits(&cdt, &stuck, &seg_of, &subsegs));
                 if debug() && !splits.is_empty() {
@@ -1139,9 +1139,9 @@ fn attempt(
         // the points as input vertices.
         let search =
             search.get_or_insert_with(|| flat_tet_search(plc, merged, &subsegs, &cdt, opts));
-        let covering = (0..cdt.dt.points.len() as VertexId)
-            .filter(|&v| free_in_place.contains(&cdt.dt.orig[v as usize]))
-            .any(|v| search.covering_face_around(&cdt, v, false));
+        let covering = free_in_place
+            .iter()
+            .any(|&v| search.covering_face_around(&cdt, v, false));
         if covering {
             if debug() {
                 eprintln!("free points put in with facets recovered again cover a facet: restart");
@@ -1597,10 +1597,15 @@ fn triangulate_again(
 ) {
     for g in gs {
         facet_tris[g] = ctx.triangles(g);
-        if !queued[g] {
-            queued[g] = true;
-            queue.push(g);
-        }
+        enqueue(queue, queued, g);
+    }
+}
+
+/// Queues facet `g` for recovery, unless it is queued already.
+fn enqueue(queue: &mut Vec<usize>, queued: &mut [bool], g: usize) {
+    if !queued[g] {
+        queued[g] = true;
+        queue.push(g);
     }
 }
 
@@ -1617,8 +1622,8 @@ fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
 
 /// What [`insert_free_unrecovering`] did with a round's refused free points.
 enum FreeInPlace {
-    /// All went in: the facets to recover again.
-    In(Vec<usize>),
+    /// All went in: their vertices, and the facets to recover again.
+    In(Vec<VertexId>, Vec<usize>),
     /// Each went in or would remove a subsegment, and those that did go in were taken
     /// back: the points that would, with their subsegments.
     Encroaching(Vec<(Point, (VertexId, VertexId))>),
@@ -1663,7 +1668,14 @@ fn insert_free_unrecovering(
     if lost.is_empty() && !left_out {
         facets.sort_unstable();
         facets.dedup();
-        return Ok(FreeInPlace::In(facets));
+        let vertices = done
+            .iter()
+            .filter_map(|(inserted, _)| match inserted {
+                free::Inserted::Yes { vertex, .. } => Some(*vertex),
+                _ => None,
+            })
+            .collect();
+        return Ok(FreeInPlace::In(vertices, facets));
     }
     // Taken back in the reverse order, each while it is the last change.
     for (inserted, removed) in done.into_iter().rev() {

@@ -164,14 +164,16 @@ impl Delaunay {
                 let tet = self.mesh.tet(t);
                 (0..4)
                     .find(|&f| {
+                        if !blocked(tet.v, f) || inside.contains(&tet.adj[f].tet()) {
+                            return false;
+                        }
+                        // The tet the fill would make on this wall: not positive.
                         let mut v = tet.v.map(|x| (x != GHOST).then(|| *self.pt(x)));
                         v[f] = Some(*p);
                         let [Some(a), Some(b), Some(c), Some(d)] = v else {
                             return false;
                         };
-                        blocked(tet.v, f)
-                            && !inside.contains(&tet.adj[f].tet())
-                            && self.filter.orient3d(&a, &b, &c, &d) <= 0.0
+                        self.filter.orient3d(&a, &b, &c, &d) <= 0.0
                     })
                     .map(|f| self.mesh.face_verts(t, f))
             })
