@@ -11,6 +11,20 @@ pub fn edge_key(a: VertexId, b: VertexId) -> (VertexId, VertexId) {
     (a.min(b), a.max(b))
 }
 
+/// The triangles of `tris` (by index) on each of their edges.
+pub fn triangles_by_edge(tris: &[[VertexId; 3]]) -> FxHashMap<(VertexId, VertexId), Vec<usize>> {
+    let mut by_edge: FxHashMap<(VertexId, VertexId), Vec<usize>> = FxHashMap::default();
+    for (i, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            by_edge
+                .entry(edge_key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(i);
+        }
+    }
+    by_edge
+}
+
 /// Sorted key of a triangle.
 #[inline]
 pub fn face_key(f: [VertexId; 3]) -> [VertexId; 3] {

@@ -1,0 +1,1110 @@
+//! One construction of the CDT from scratch: the Delaunay tetrahedralization of the
+//! input points (with the Steiner points earlier constructions asked for), segment
+//! recovery, facet recovery with the updates in place its Steiner points need, shims
+//! and free points for the flat tets left on facets. What it cannot settle in place it
+//! hands back as the points and splits of the next construction.
+
+use super::cavity::Outcome;
+use super::cdt::{edge_key, face_key, triangles_by_edge, Cdt};
+use super::in_place::{
+    for_each_facet_segment, insert_free_unrecovering, insert_unrecovered, midpoint_parameter,
+    split_encroached, FreeInPlace, Segs, MAX_IN_PLACE, MAX_IN_PLACE_EACH,
+};
+use super::prepare::PreparedPlc;
+use super::{
+    debug, free, max_facet_points, restart_work_bound, segments, slivers, FacetContext, FacetPoint,
+    FacetTris, PlcOptions, PlcStats, SegmentSplit, FREE_POINT, RESTART_WORK,
+};
+use crate::carve::{carve, Carved};
+use crate::delaunay::Delaunay;
+use crate::error::{Error, MeshError};
+use crate::geom::Point;
+use crate::mesh::{VertexId, VertexLists};
+use crate::plc::Plc;
+use crate::progress::{Progress, Stage};
+use rustc_hash::{FxHashMap, FxHashSet};
+use std::time::Instant;
+
+/// At most this many tets left on facets are worth other constructions (fans of needle
+/// triangles leave many, which no single point removes).
+const MAX_RETRY_TETS: usize = 4;
+
+/// Restarts after which flat tets no longer get free points (see [`slivers`]).
+const MAX_FREE_ROUNDS: usize = 12;
+
+/// Work ([`slivers::free_points`]) that the search for free points may do in one
+/// construction, per tet slot of the mesh (the corpus takes at most 17 per slot, on
+/// `112544.off`)...
+const FREE_SEARCH_WORK_PER_SLOT: u64 = 64;
+/// ... and beyond that, for small meshes.
+const FREE_SEARCH_WORK: u64 = 1_000_000;
+
+/// Restarts after which free points the CDT refuses and flat-tet splits no longer start
+/// the construction again: each costs a whole construction, and past a few they do not
+/// converge (on fans of needle triangles every restart finds new flat tets).
+const MAX_FREE_RESTARTS: usize = 3;
+
+/// A finished CDT, before carving and output.
+pub(super) struct Built {
+    pub cdt: Cdt,
+    /// The subsegments with their markers.
+    pub seg_markers: FxHashMap<(VertexId, VertexId), i32>,
+    /// The CDT's carving, if one was made since it last changed.
+    pub carved: Option<Carved>,
+    /// How many flat tets lie on one facet (of the all-merged facets), and the facet of
+    /// the first.
+    pub flat_left: (usize, Option<u32>),
+    /// When a few tets are left on facets: points for another construction that may
+    /// leave none (see [`slivers::flat_left`]).
+    pub retry_points: Vec<Point>,
+    /// Whether a face around the first earlier point (a retry's own point) lies on a
+    /// facet beside its triangles.
+    pub first_point_covers: bool,
+}
+
+/// How a construction ended.
+pub(super) enum Attempt {
+    /// With a CDT.
+    Done(Box<Built>),
+    /// Asking for another, with these points and splits.
+    Restart(Vec<FacetPoint>, Vec<SegmentSplit>),
+}
+
+/// One construction from scratch: Delaunay, segments, facets. `prep` is the PLC as
+/// meshed, `merged` with every coplanar group merged (for [`slivers`]).
+pub(super) fn attempt(
+    plc: &Plc,
+    built: Option<(Delaunay, f64)>,
+    [prep, merged]: [&PreparedPlc; 2],
+    (facet_points, presplits): (&[FacetPoint], &[SegmentSplit]),
+    opts: &PlcOptions,
+    (stats, work_limit): (&mut PlcStats, u64),
+    progress: Progress<'_>,
+) -> Result<Attempt, Error> {
+    let mut c = Construction::new(
+        plc,
+        built,
+        [prep, merged],
+        (facet_points, presplits),
+        opts,
+        (stats, work_limit),
+        progress,
+    )?;
+    // Free points whose cavities wrap around subfaces go in with those facets taken out,
+    // which are then recovered again: the facet recovery, the shims and the free points
+    // run again, pass after pass, on the one CDT (the free points' rounds, their search
+    // and its budget are counted over them all).
+    loop {
+        c.recover_facets()?;
+        if !c.settle_flat_tets()? {
+            break;
+        }
+    }
+    c.finish()
+}
+
+/// The segments' state of construction `$c` that splits in place update, borrowed apart
+/// from its CDT (a macro, since a method would borrow the whole construction).
+macro_rules! segs {
+    ($c:expr) => {
+        Segs {
+            subsegs: &mut $c.subsegs,
+            seg_of: &mut $c.seg_of,
+            markers: &mut $c.seg_markers,
+            facets_of: &mut $c.facets_of_seg,
+            prep: $c.prep,
+            seg_index: &$c.seg_index,
+        }
+    };
+}
+
+/// The state of one construction, from its segment recovery on.
+struct Construction<'a> {
+    plc: &'a Plc,
+    prep: &'a PreparedPlc,
+    merged: &'a PreparedPlc,
+    opts: &'a PlcOptions,
+    /// The points of earlier constructions that this one starts with.
+    facet_points: &'a [FacetPoint],
+    /// The splits of earlier constructions that its segment recovery starts with.
+    presplits: &'a [SegmentSplit],
+    stats: &'a mut PlcStats,
+    n_input: usize,
+    /// Internal vertex ids of the points (input, then earlier Steiner points).
+    inv: Vec<VertexId>,
+    /// Each segment of `prep` by its input ends.
+    seg_index: FxHashMap<(u32, u32), usize>,
+    cdt: Cdt,
+    subsegs: segments::Subsegments,
+    seg_markers: FxHashMap<(VertexId, VertexId), i32>,
+    seg_of: FxHashMap<(VertexId, VertexId), usize>,
+    /// The Steiner points on each facet.
+    extra: Vec<Vec<VertexId>>,
+    facet_tris: Vec<FacetTris>,
+    next_pert: u32,
+    /// Facets to recover, and which are queued.
+    queue: Vec<usize>,
+    queued: Vec<bool>,
+    /// Points and splits for the next construction, and the facets that asked for them.
+    steiner: Vec<FacetPoint>,
+    steiner_facets: FxHashSet<usize>,
+    splits: Vec<SegmentSplit>,
+    rounds: usize,
+    max_rounds: usize,
+    /// Steiner points put on facets in this construction.
+    placed_on_facets: usize,
+    /// Updates of the CDT in place of a restart (see `split_encroached`), bounded in all
+    /// and for each Steiner point (one that keeps asking for them is better made an
+    /// input vertex).
+    in_place: usize,
+    in_place_for: FxHashMap<[u64; 3], usize>,
+    /// The splits and points they made, for the next construction if there is one.
+    carried: (Vec<SegmentSplit>, Vec<FacetPoint>),
+    /// The subsegments' ends, which points put in check, while they stand.
+    ends: Option<VertexLists<VertexId>>,
+    /// Facets to triangulate again once the current one is done (after a subsegment was
+    /// split in place), and the facets of each segment, made when first needed.
+    retriangulate: Vec<usize>,
+    facets_of_seg: Option<Vec<Vec<usize>>>,
+    /// What the flat-tet search needs, made once when first needed (free points leave
+    /// the subsegments as they are, but facets recovered again may split some: then its
+    /// record of them is made again), and the segment splits it knows of.
+    search: Option<slivers::Search<'a>>,
+    search_splits: usize,
+    /// The free points put in with facets recovered again, and the points the first of
+    /// them stood in for a restart with.
+    free_in_place: Vec<VertexId>,
+    restart_instead: Option<Vec<FacetPoint>>,
+    /// Whether refused free points have given way to subsegment splits.
+    free_splits: bool,
+    free_rounds: usize,
+    budget: Option<u64>,
+    /// The carving of the CDT as it stands, while nothing changes it.
+    carved: Option<Carved>,
+    /// The flat tets left on facets, when known (`None` after points went in).
+    flat_left: Option<(usize, Option<u32>)>,
+    /// The work of the construction before its free points (their search is bounded
+    /// apart).
+    facet_work: u64,
+    /// When facet recovery started.
+    t_facets: Instant,
+}
+
+impl<'a> Construction<'a> {
+    /// Builds the Delaunay tetrahedralization (or takes `built`), recovers the segments
+    /// and triangulates the facets, all queued for recovery.
+    fn new(
+        plc: &'a Plc,
+        built: Option<(Delaunay, f64)>,
+        [prep, merged]: [&'a PreparedPlc; 2],
+        (facet_points, presplits): (&'a [FacetPoint], &'a [SegmentSplit]),
+        opts: &'a PlcOptions,
+        (stats, work_limit): (&'a mut PlcStats, u64),
+        progress: Progress<'_>,
+    ) -> Result<Self, Error> {
+        let n_input = plc.points.len();
+        let mut points = plc.points.clone();
+        points.extend(facet_points.iter().map(|&(_, p)| p));
+        // Duplicated input points go to their representative; only those are meshed.
+        let mut dt = match built {
+            // Built beforehand, of the input points only.
+            Some((dt, secs)) if facet_points.is_empty() => {
+                stats.delaunay_secs = secs;
+                dt
+            }
+            _ => {
+                progress(Stage::Delaunay);
+                let t0 = Instant::now();
+                let dt = Delaunay::build(&points)?.dt;
+                stats.delaunay_secs = t0.elapsed().as_secs_f64();
+                dt
+            }
+        };
+
+        progress(Stage::Segments);
+        let t1 = Instant::now();
+        let mut next_pert = points.len() as u32;
+        let budget = opts.max_steiner.saturating_sub(facet_points.len());
+        let subsegs = segments::recover_segments(
+            &mut dt,
+            &prep.segments,
+            points.len(),
+            &mut next_pert,
+            budget,
+            presplits,
+            opts.cancel_flag(),
+        )?;
+        stats.segment_secs = t1.elapsed().as_secs_f64();
+        stats.steiner_points = facet_points.len() + subsegs.steiner_points;
+
+        progress(Stage::Facets);
+        let t_facets = Instant::now();
+        let inv = dt.internal_ids(points.len());
+        let seg_index: FxHashMap<(u32, u32), usize> = prep
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| ((s[0], s[1]), i))
+            .collect();
+        // Each subsegment takes the marker of the first facet that contains its segment.
+        let mut seg_marker = vec![None; prep.segments.len()];
+        for_each_facet_segment(prep, &seg_index, |fi, si| {
+            seg_marker[si].get_or_insert(prep.facets[fi].marker);
+        });
+        // Sized up front: growing maps of this many entries rehashes them over and over.
+        let pieces: usize = subsegs.chains.iter().map(|c| c.len() - 1).sum();
+        let mut seg_markers =
+            FxHashMap::with_capacity_and_hasher(pieces, rustc_hash::FxBuildHasher);
+        let mut seg_of: FxHashMap<(VertexId, VertexId), usize> =
+            FxHashMap::with_capacity_and_hasher(pieces, rustc_hash::FxBuildHasher);
+        for (i, chain) in subsegs.chains.iter().enumerate() {
+            for w in chain.windows(2) {
+                seg_markers.insert(edge_key(w[0], w[1]), seg_marker[i].unwrap_or(0));
+                seg_of.insert(edge_key(w[0], w[1]), i);
+            }
+        }
+        let mut extra: Vec<Vec<VertexId>> = vec![Vec::new(); prep.facets.len()];
+        for (k, &(f, _)) in facet_points.iter().enumerate() {
+            let v = inv[n_input + k];
+            if v != u32::MAX && f != FREE_POINT {
+                extra[f].push(v);
+            }
+        }
+        // Each facet's triangles depend only on its vertices and subsegments, not on the
+        // tets: all are computed up front, on two cores, and only they are indexed for the
+        // lookups of the mesh faces.
+        let t_surface = Instant::now();
+        let facet_tris =
+            FacetContext::new(plc, prep, &dt, &inv, &seg_index, &subsegs, &extra).triangulate_all();
+        stats.surface_secs = t_surface.elapsed().as_secs_f64();
+        let wanted: Vec<[VertexId; 3]> = facet_tris
+            .iter()
+            .flat_map(|r| r.as_ref().ok().into_iter().flatten().flatten())
+            .map(|t| face_key(*t))
+            .collect();
+        let mut cdt = Cdt::new(dt);
+        cdt.work_limit = work_limit;
+        cdt.index_faces_of(&wanted);
+        cdt.subfaces.reserve(wanted.len());
+        cdt.subsegs = seg_markers.clone();
+        let mut queue: Vec<usize> = (0..prep.facets.len()).collect();
+        queue.reverse();
+        stats.facet_steiner_points = 0;
+        stats.free_steiner_points = 0;
+        Ok(Construction {
+            plc,
+            prep,
+            merged,
+            opts,
+            facet_points,
+            presplits,
+            stats,
+            n_input,
+            inv,
+            seg_index,
+            cdt,
+            subsegs,
+            seg_markers,
+            seg_of,
+            extra,
+            facet_tris,
+            next_pert,
+            queue,
+            queued: vec![true; prep.facets.len()],
+            steiner: Vec::new(),
+            steiner_facets: FxHashSet::default(),
+            splits: Vec::new(),
+            rounds: 0,
+            max_rounds: 20 * prep.facets.len() + 1000,
+            placed_on_facets: 0,
+            in_place: 0,
+            in_place_for: FxHashMap::default(),
+            carried: (Vec::new(), Vec::new()),
+            ends: None,
+            retriangulate: Vec::new(),
+            facets_of_seg: None,
+            search: None,
+            search_splits: 0,
+            free_in_place: Vec::new(),
+            restart_instead: None,
+            free_splits: false,
+            free_rounds: 0,
+            budget: None,
+            carved: None,
+            flat_left: None,
+            facet_work: 0,
+            t_facets,
+        })
+    }
+
+    /// Recovers the queued facets, with the Steiner points and updates in place they
+    /// ask for.
+    fn recover_facets(&mut self) -> Result<(), Error> {
+        while let Some(fi) = self.queue.pop() {
+            self.opts.check_cancel()?;
+            self.queued[fi] = false;
+            self.rounds += 1;
+            if self.rounds > self.max_rounds {
+                return Err(MeshError::Failed("facet recovery does not converge".into()).into());
+            }
+            if self.steiner_facets.contains(&fi) {
+                continue;
+            }
+            // Taken out while the facet is recovered (an error is returned), and put back
+            // unless the facet is triangulated again.
+            let Some(tris) = std::mem::replace(&mut self.facet_tris[fi], Ok(None))? else {
+                continue;
+            };
+            self.facet_tris[fi] = match self.recover_facet(fi, &tris)? {
+                Some(again) => again,
+                None => Ok(Some(tris)),
+            };
+            if !self.retriangulate.is_empty() {
+                let gs = std::mem::take(&mut self.retriangulate);
+                self.triangulate_again(gs);
+            }
+        }
+        Ok(())
+    }
+
+    /// Recovers facet `fi`, whose triangles are `tris`, region after region. Its new
+    /// triangles, if a Steiner point went in on it.
+    fn recover_facet(
+        &mut self,
+        fi: usize,
+        tris: &[[VertexId; 3]],
+    ) -> Result<Option<FacetTris>, Error> {
+        let normal = self.prep.facets[fi].normal;
+        let mut missing = Vec::new();
+        for t in tris {
+            if self.cdt.has_face(t[0], t[1], t[2]) {
+                self.cdt.subfaces.insert(face_key(*t), fi as u32);
+            } else {
+                missing.push(*t);
+            }
+        }
+        for region in regions_of(&missing, &self.seg_markers) {
+            let stats = &mut *self.stats;
+            let fallbacks = stats.flips.fallbacks;
+            let outcome = self.opts.inserter.insert(
+                &mut self.cdt,
+                &region,
+                fi as u32,
+                normal,
+                &mut stats.flips,
+            )?;
+            if stats.flips.fallbacks > fallbacks {
+                stats.flip_fallback_facets.push(fi as u32);
+            }
+            match outcome {
+                Outcome::Inserted(rs) => {
+                    stats.regions += 1;
+                    stats.recovered_subfaces += rs.subfaces;
+                    stats.max_region_subfaces = stats.max_region_subfaces.max(rs.subfaces);
+                    stats.crossing_tets += rs.crossing_tets;
+                    stats.max_region_crossing_tets =
+                        stats.max_region_crossing_tets.max(rs.crossing_tets);
+                    stats.enlarged_tets += rs.enlarged_tets;
+                    for lf in rs.lost {
+                        if let Some(q) = self.queued.get_mut(lf as usize).filter(|q| !**q) {
+                            *q = true;
+                            self.queue.push(lf as usize);
+                        }
+                    }
+                }
+                Outcome::NeedsSteiner(p) => {
+                    if debug() {
+                        eprintln!("facet {fi}: Steiner point {p:?}");
+                    }
+                    return self.facet_point(fi, p, tris);
+                }
+                Outcome::SplitSubsegment(u, v) => {
+                    if debug() {
+                        eprintln!("facet {fi}: split subsegment {u}-{v}");
+                    }
+                    let seg = self.seg_of[&edge_key(u, v)];
+                    let chain = &self.subsegs.chains[seg];
+                    self.splits
+                        .push((seg, midpoint_parameter(&self.cdt, chain, u, v)));
+                    self.steiner_facets.insert(fi);
+                    return Ok(None);
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Steiner point `p` on facet `fi` (whose triangles are `tris`): it goes straight into
+    /// the CDT, and the facet is triangulated again with it (returned), if its triangles
+    /// already in the mesh keep their place; otherwise an update in place (a split of a
+    /// subsegment it encroaches upon, or the point in with the facets in its way
+    /// unrecovered) is tried; failing that, the next construction gets it.
+    fn facet_point(
+        &mut self,
+        fi: usize,
+        p: Point,
+        tris: &[[VertexId; 3]],
+    ) -> Result<Option<FacetTris>, Error> {
+        let room = self.stats.steiner_points < self.opts.max_steiner
+            && self.placed_on_facets < max_facet_points(self.plc);
+        let asked = self.in_place_for.entry(p.map(f64::to_bits)).or_insert(0);
+        // Updates are meant to be cheaper than a restart: not once this construction has
+        // done a restart's worth of work.
+        let update = !self.stats.in_place_off
+            && self.in_place < MAX_IN_PLACE
+            && *asked < MAX_IN_PLACE_EACH
+            && self.stats.work + self.cdt.work.get() < RESTART_WORK / 4;
+        *asked += 1;
+        if room {
+            let at = self
+                .ends
+                .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
+            let inserted = free::insert_point(&mut self.cdt, p, self.next_pert, at, false)?;
+            // Refused, and for which subsegment if one would be lost.
+            let refused = match &inserted {
+                free::Inserted::Refused { lost, .. } => Some(*lost),
+                _ => None,
+            };
+            if let free::Inserted::Yes { vertex, .. } = inserted {
+                self.extra[fi].push(vertex);
+                let again = self.triangles(fi);
+                if let Ok(Some(new)) = &again {
+                    let keys: FxHashSet<[VertexId; 3]> = new.iter().map(|t| face_key(*t)).collect();
+                    let kept = tris.iter().map(|t| face_key(*t)).all(|k| {
+                        self.cdt.subfaces.get(&k) != Some(&(fi as u32)) || keys.contains(&k)
+                    });
+                    if kept {
+                        self.next_pert += 1;
+                        self.placed_on_facets += 1;
+                        self.stats.steiner_points += 1;
+                        self.stats.facet_steiner_points += 1;
+                        self.queued[fi] = true;
+                        self.queue.push(fi);
+                        return Ok(Some(again));
+                    }
+                }
+                if debug() {
+                    eprintln!("facet {fi}: its triangles would move with the point");
+                }
+                self.extra[fi].pop();
+                free::take_back(&mut self.cdt, inserted);
+            } else if debug() {
+                eprintln!("facet {fi}: the CDT refuses the point");
+            }
+            // A point refused for encroaching upon a subsegment: the subsegment is split
+            // in place instead, and the facets through it are triangulated and recovered
+            // again (the paper's update of a CDT), which spares a whole construction.
+            // Failing that, the point lies on the facet, whose own subfaces need not wall
+            // it in: without them (and those it wraps around) it may go in, and the
+            // facets are triangulated with it and recovered again.
+            let mut segs = segs!(self);
+            let at = self
+                .ends
+                .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
+            let cdt = &mut self.cdt;
+            let pert = self.next_pert;
+            let (mut split, mut unrecovered) = (None, None);
+            if let (Some(lost), true) = (refused, update) {
+                split = split_encroached(cdt, p, lost, &mut segs, pert, 0)?;
+                if split.is_none() {
+                    match insert_unrecovered(cdt, p, fi, pert, at)? {
+                        Ok(done) => unrecovered = Some(done),
+                        // Then the subsegment it would remove is split.
+                        Err(Some(lost)) => {
+                            split = split_encroached(cdt, p, Some(lost), &mut segs, pert, 0)?;
+                        }
+                        Err(None) => {}
+                    }
+                }
+            }
+            let mut points = 1;
+            let facets = match (split, unrecovered) {
+                (Some((facets, at_splits)), _) => {
+                    points = at_splits.len() as u32;
+                    self.carried.0.extend(at_splits);
+                    Some(facets)
+                }
+                (None, Some((v, facets))) => {
+                    if debug() {
+                        eprintln!("facet {fi}: in with facets {facets:?} unrecovered");
+                    }
+                    self.carried.1.push((fi, p));
+                    self.extra[fi].push(v);
+                    self.placed_on_facets += 1;
+                    self.stats.facet_steiner_points += 1;
+                    Some(facets)
+                }
+                (None, None) => {
+                    if debug() {
+                        eprintln!(
+                            "facet {fi}: no update in place (allowed {update}, refused for {refused:?})"
+                        );
+                    }
+                    None
+                }
+            };
+            if let Some(facets) = facets {
+                self.ends = None;
+                self.next_pert += points;
+                self.stats.steiner_points += points as usize;
+                count_update(&mut self.cdt, &mut self.in_place, self.stats);
+                self.retriangulate.extend(facets);
+                self.retriangulate.push(fi);
+                return Ok(None);
+            }
+        }
+        self.steiner.push((fi, p));
+        self.steiner_facets.insert(fi);
+        Ok(None)
+    }
+
+    /// Triangulates facets `gs` again (a subsegment on them was split, or a point went
+    /// in on them), and queues them for recovery.
+    fn triangulate_again(&mut self, gs: impl IntoIterator<Item = usize>) {
+        for g in gs {
+            self.facet_tris[g] = self.triangles(g);
+            enqueue(&mut self.queue, &mut self.queued, g);
+        }
+    }
+
+    /// Facet `g`'s triangles, with the vertices and subsegments it has now.
+    fn triangles(&self, g: usize) -> FacetTris {
+        let (dt, extra) = (&self.cdt.dt, &self.extra);
+        FacetContext::new(
+            self.plc,
+            self.prep,
+            dt,
+            &self.inv,
+            &self.seg_index,
+            &self.subsegs,
+            extra,
+        )
+        .triangles(g)
+    }
+
+    /// After facet recovery: the shims, then rounds of free points for the flat tets
+    /// left on facets, then splits for those the points cannot remove. Whether facets
+    /// were taken out for free points, to be recovered again.
+    fn settle_flat_tets(&mut self) -> Result<bool, Error> {
+        self.stats.facet_secs = self.t_facets.elapsed().as_secs_f64() - self.stats.surface_secs;
+        self.facet_work = self.cdt.work.get();
+        self.carved = None;
+        if self.steiner.is_empty() && self.splits.is_empty() {
+            let (more, c) = resolve_shims(&mut self.cdt, self.plc, self.opts);
+            self.steiner.extend(more);
+            self.carved = c;
+        }
+        self.flat_left = None;
+        if !(self.steiner.is_empty()
+            && self.splits.is_empty()
+            && self.stats.restarts < MAX_FREE_ROUNDS)
+        {
+            return Ok(false);
+        }
+        // Taken out while the rounds run, which change the rest of the state.
+        let mut search = match self.search.take() {
+            Some(search) => search,
+            None => {
+                self.search_splits = self.subsegs.steiner_points;
+                flat_tet_search(self.plc, self.merged, &self.subsegs, &self.cdt, self.opts)
+            }
+        };
+        if self.search_splits != self.subsegs.steiner_points {
+            self.search_splits = self.subsegs.steiner_points;
+            search.seg_ends = segment_ends(&self.subsegs, &self.cdt.dt.orig);
+        }
+        // Room for a restart (for free points or flat tets' splits) in this pass.
+        let restart_room = self.stats.restarts < MAX_FREE_RESTARTS
+            && self.stats.work + self.facet_work < RESTART_WORK / 4;
+        let rounds = self.free_point_rounds(&search, restart_room);
+        self.search = Some(search);
+        let Some(stuck) = rounds? else {
+            return Ok(true);
+        };
+        self.stats.steiner_points += self.stats.free_steiner_points;
+
+        // A flat tet whose circumsphere lies within its facet's slab spans a gap between
+        // segments closer than the slab is thick. Its size, not its shape, makes it flat:
+        // splitting its longest subsegment makes the tets there smaller against the gap.
+        // Like free points, they only improve a valid CDT: only while the restart they
+        // cost stays well within the bounds on restarts and their work.
+        let affordable =
+            restart_room && 2 * (self.presplits.len() + stuck.len()) <= max_facet_points(self.plc);
+        if self.steiner.is_empty() && affordable {
+            let more = flat_tet_splits(&self.cdt, &stuck, &self.seg_of, &self.subsegs);
+            self.splits.extend(more);
+            if debug() && !self.splits.is_empty() {
+                eprintln!("flat tets {stuck:?}: splits {:?}", self.splits);
+            }
+        }
+        Ok(false)
+    }
+
+    /// Free points go straight into the CDT (`free.rs`), round after round; only if none
+    /// of a round's can does the construction start again with them, or, in its place,
+    /// they go in with facets taken out or give way to subsegment splits (`None`: those
+    /// facets are to be recovered again). Otherwise the flat tets that no point could be
+    /// found for.
+    fn free_point_rounds(
+        &mut self,
+        search: &slivers::Search<'a>,
+        restart_room: bool,
+    ) -> Result<Option<Vec<[VertexId; 4]>>, Error> {
+        let mut stuck = Vec::new();
+        // The search tests candidate places against the slabs near them and walks to
+        // them; around a vertex far out of the model's scale the slabs' boxes grow and
+        // the walks get long, and it gives up past this much work.
+        let slots = self.cdt.dt.mesh.num_slots() as u64;
+        let budget = self
+            .budget
+            .get_or_insert_with(|| FREE_SEARCH_WORK_PER_SLOT * slots + FREE_SEARCH_WORK);
+        while self.free_rounds < MAX_FREE_ROUNDS {
+            self.free_rounds += 1;
+            let found = slivers::free_points(&mut self.cdt, search, &mut self.carved, budget);
+            self.flat_left = Some(found.found);
+            let free = found.points;
+            stuck = found.stuck;
+            if debug() && !free.is_empty() {
+                eprintln!("free points {free:?}");
+            }
+            // They only improve a valid CDT: within -S, or not at all.
+            let room = self
+                .opts
+                .max_steiner
+                .saturating_sub(self.stats.steiner_points + self.stats.free_steiner_points);
+            let free = &free[..free.len().min(room)];
+            if free.is_empty() {
+                break;
+            }
+            let (added, refused) =
+                free::insert_free(&mut self.cdt, free, &mut self.next_pert, |cdt, v| {
+                    !search.on_facet_around(cdt, v)
+                })?;
+            self.stats.free_steiner_points += added;
+            if added > 0 {
+                self.carved = None;
+                self.flat_left = None;
+                continue;
+            }
+            // None fits into the CDT as it stands: the construction starts again with
+            // them, if that restart stays well within the bounds on restarts.
+            if debug() {
+                eprintln!("free points refused by the CDT: {refused:?}");
+            }
+            // A point that an earlier attempt already had is not tried again.
+            let new: Vec<FacetPoint> = refused
+                .iter()
+                .filter(|p| !self.facet_points.iter().any(|(_, q)| q == *p))
+                .map(|&p| (FREE_POINT, p))
+                .collect();
+            // Rather than that, the refused points go in with the facets whose subfaces
+            // their cavities wrap around taken out, and those are recovered again. Only
+            // where the restart could still come: should a face around such a point
+            // cover a facet once those are recovered, it does.
+            let update = restart_room
+                && !new.is_empty()
+                && !self.stats.in_place_off
+                && self.in_place + refused.len() <= MAX_IN_PLACE;
+            if update && self.free_in_place_update(&refused)? {
+                self.restart_instead.get_or_insert_with(|| new.clone());
+                return Ok(None);
+            }
+            if restart_room {
+                self.steiner.extend(new);
+            }
+            break;
+        }
+        Ok(Some(stuck))
+    }
+
+    /// Puts free points `refused`, which the CDT refuses as it stands, in with the
+    /// facets their cavities wrap around taken out, or else (once per construction)
+    /// splits the subsegments they would remove. Whether either was done: the facets
+    /// are then queued to be recovered again.
+    fn free_in_place_update(&mut self, refused: &[Point]) -> Result<bool, Error> {
+        let at = self
+            .ends
+            .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
+        match insert_free_unrecovering(&mut self.cdt, refused, self.next_pert, at)? {
+            FreeInPlace::In(vertices, facets) => {
+                if debug() {
+                    eprintln!("free points {refused:?}: in with facets {facets:?} unrecovered");
+                }
+                for &v in &vertices {
+                    self.free_in_place.push(v);
+                    self.next_pert += 1;
+                    self.stats.free_steiner_points += 1;
+                    count_update(&mut self.cdt, &mut self.in_place, self.stats);
+                }
+                for g in facets {
+                    enqueue(&mut self.queue, &mut self.queued, g);
+                }
+                Ok(true)
+            }
+            FreeInPlace::Encroaching(lost) if !self.free_splits => {
+                // As in Ruppert's refinement, a free point that would remove a subsegment
+                // gives way to a split of it (in place, with the facets through it
+                // triangulated and recovered again); the next round finds the flat tets'
+                // points anew. Once only: at a corner whose flat tets' spheres lie in a
+                // slab (`mpi.off`) the next points encroach again, closer to the corner
+                // each time. Nor are these splits carried into a restart, which is then
+                // the one they stood in for.
+                self.free_splits = true;
+                let mut segs = segs!(self);
+                let mut again = Vec::new();
+                for (p, e) in lost {
+                    let split =
+                        split_encroached(&mut self.cdt, p, Some(e), &mut segs, self.next_pert, 0)?;
+                    let Some((facets, at_splits)) = split else {
+                        continue;
+                    };
+                    if debug() {
+                        eprintln!("free point {p:?}: splits {at_splits:?} instead");
+                    }
+                    self.next_pert += at_splits.len() as u32;
+                    self.stats.steiner_points += at_splits.len();
+                    count_update(&mut self.cdt, &mut self.in_place, self.stats);
+                    again.extend(facets);
+                }
+                if again.is_empty() {
+                    return Ok(false);
+                }
+                self.ends = None;
+                self.triangulate_again(again);
+                Ok(true)
+            }
+            _ => Ok(false),
+        }
+    }
+
+    /// The construction's end: a restart with the points and splits it asked for, or
+    /// its CDT with what the retries need to know.
+    fn finish(mut self) -> Result<Attempt, Error> {
+        self.stats.work += self.facet_work;
+        if self.budget == Some(0) {
+            self.stats.free_searches_cut += 1;
+        }
+        let (plc, merged, opts) = (self.plc, self.merged, self.opts);
+        if self.steiner.is_empty() && self.splits.is_empty() && !self.free_in_place.is_empty() {
+            // A face around such a point that lies on a facet beside its triangles (in the
+            // slab of a facet far from flat) makes the construction start again instead,
+            // with the points as input vertices.
+            let search = self.search.get_or_insert_with(|| {
+                flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
+            });
+            let covering = self
+                .free_in_place
+                .iter()
+                .any(|&v| search.covering_face_around(&self.cdt, v, false));
+            if covering {
+                if debug() {
+                    eprintln!(
+                        "free points put in with facets recovered again cover a facet: restart"
+                    );
+                }
+                self.steiner
+                    .extend(self.restart_instead.take().into_iter().flatten());
+            }
+        }
+        if !self.steiner.is_empty() || !self.splits.is_empty() {
+            // What the updates in place put in goes into the next construction too, which
+            // would otherwise have to find it again. Free points put in with facets
+            // recovered again stood in for a restart: the points it would have had go into
+            // this one.
+            let (mut steiner, mut splits) = (self.steiner, self.splits);
+            let (more_splits, more_points) = self.carried;
+            splits.extend(more_splits);
+            steiner.extend(more_points);
+            for p in self.restart_instead.into_iter().flatten() {
+                if !steiner.contains(&p) {
+                    steiner.push(p);
+                }
+            }
+            return Ok(Attempt::Restart(steiner, splits));
+        }
+        let (flat_left, retry_points) = match self.flat_left {
+            // Known, and too many (or none) for other constructions: no search needed.
+            Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.0) => (known, Vec::new()),
+            _ => {
+                let search = self.search.get_or_insert_with(|| {
+                    flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
+                });
+                slivers::flat_left(&mut self.cdt, search, &mut self.carved, MAX_RETRY_TETS)
+            }
+        };
+        let first_point_covers = match self.facet_points.first() {
+            Some(&(FREE_POINT, _)) => {
+                let v = self
+                    .inv
+                    .get(self.n_input)
+                    .copied()
+                    .filter(|&v| v != u32::MAX);
+                let search = self.search.get_or_insert_with(|| {
+                    flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
+                });
+                v.is_some_and(|v| search.covering_face_around(&self.cdt, v, true))
+            }
+            _ => false,
+        };
+        Ok(Attempt::Done(Box::new(Built {
+            cdt: self.cdt,
+            seg_markers: self.seg_markers,
+            carved: self.carved,
+            flat_left,
+            retry_points,
+            first_point_covers,
+        })))
+    }
+}
+
+/// Queues facet `g` for recovery, unless it is queued already.
+fn enqueue(queue: &mut Vec<usize>, queued: &mut [bool], g: usize) {
+    if !queued[g] {
+        queued[g] = true;
+        queue.push(g);
+    }
+}
+
+/// Counts an update of the CDT in place of a restart. Updates stand in for restarts, and
+/// are bounded as they are, by the work done before the first one.
+fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
+    stats.in_place_splits += 1;
+    *in_place += 1;
+    if *in_place == 1 {
+        let before = cdt.work.get();
+        cdt.work_limit = cdt.work_limit.min(before + restart_work_bound(before));
+    }
+}
+
+/// What the search for flat tets on facets needs besides the CDT.
+fn flat_tet_search<'a>(
+    plc: &'a Plc,
+    merged: &'a PreparedPlc,
+    subsegs: &segments::Subsegments,
+    cdt: &Cdt,
+    opts: &PlcOptions,
+) -> slivers::Search<'a> {
+    slivers::Search {
+        prep: merged,
+        input: &plc.points,
+        seg_ends: segment_ends(subsegs, &cdt.dt.orig),
+        domain: slivers::Domain {
+            holes: &plc.holes,
+            regions: &plc.regions,
+            keep_hull: opts.keep_hull,
+        },
+        index: Default::default(),
+    }
+}
+
+/// The input ends of the segment of each Steiner point on one (`orig` maps vertices to
+/// input indices), which name the facets a flat tet of such points may lie on.
+fn segment_ends(subsegs: &segments::Subsegments, orig: &[u32]) -> FxHashMap<VertexId, [u32; 2]> {
+    let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
+    for chain in subsegs.chains.iter().filter(|c| c.len() > 2) {
+        let ends = [chain[0], chain[chain.len() - 1]].map(|x| orig[x as usize]);
+        for &v in &chain[1..chain.len() - 1] {
+            seg_ends.insert(v, ends);
+        }
+    }
+    seg_ends
+}
+
+/// For each flat tet, the split of its longest edge that is a subsegment, as (segment,
+/// parameter along it).
+fn flat_tet_splits(
+    cdt: &Cdt,
+    stuck: &[[VertexId; 4]],
+    seg_of: &FxHashMap<(VertexId, VertexId), usize>,
+    subsegs: &segments::Subsegments,
+) -> Vec<(usize, f64)> {
+    let mut out: Vec<(usize, f64)> = Vec::new();
+    let mut split: FxHashSet<(VertexId, VertexId)> = FxHashSet::default();
+    for v in stuck {
+        let len2 = |&(a, b): &(VertexId, VertexId)| {
+            let d = crate::geom::sub(&cdt.dt.points[a as usize], &cdt.dt.points[b as usize]);
+            crate::geom::dot(&d, &d)
+        };
+        let longest = crate::mesh::EDGE_VERTS
+            .iter()
+            .map(|&(i, j)| edge_key(v[i], v[j]))
+            .filter(|e| seg_of.contains_key(e))
+            .max_by(|x, y| len2(x).total_cmp(&len2(y)));
+        if let Some(e) = longest {
+            if split.insert(e) {
+                let seg = seg_of[&e];
+                out.push((seg, midpoint_parameter(cdt, &subsegs.chains[seg], e.0, e.1)));
+            }
+        }
+    }
+    out
+}
+
+/// Removes shim tets (four vertices on one facet) from the domain. A shim that carving
+/// would keep has its two subfaces on the outer side; taking its other two faces as the
+/// polygon's triangles instead puts it outside, where carving removes it. A shim that
+/// both sides keep (an inner polygon) needs a Steiner point on the polygon: those points
+/// are returned, and the construction starts again. Also returns the carving of the CDT
+/// as left, if one was made.
+pub(super) fn resolve_shims(
+    cdt: &mut Cdt,
+    plc: &Plc,
+    opts: &PlcOptions,
+) -> (Vec<(usize, Point)>, Option<Carved>) {
+    // A shim has four vertices on one facet, and facets of three vertices have none:
+    // each vertex lists the facets of more than one subface it is on. These short lists
+    // rule out most tets without looking up their faces. (Swaps below exchange a shim's
+    // subfaces for its other faces, on the same four vertices: the lists stay right.)
+    let on = {
+        let facets = cdt.subfaces.values().max().map_or(0, |&f| f as usize + 1);
+        let mut count = vec![0u32; facets];
+        for &f in cdt.subfaces.values() {
+            count[f as usize] += 1;
+        }
+        let mut pairs: Vec<(VertexId, u32)> = cdt
+            .subfaces
+            .iter()
+            .filter(|(_, &f)| count[f as usize] > 1)
+            .flat_map(|(k, &f)| k.map(|v| (v, f)))
+            .collect();
+        if pairs.is_empty() {
+            return (Vec::new(), None);
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        crate::mesh::VertexLists::new(cdt.dt.points.len(), pairs.into_iter())
+    };
+    let on_facet = |x: VertexId, f: u32| on.of(x).contains(&f);
+    let mut carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
+    for _round in 0..64 {
+        let kept = carved.kept_mask(cdt.dt.mesh.num_slots());
+        let mut swapped: Vec<crate::mesh::TetId> = Vec::new();
+        let mut needs: Vec<(usize, Point)> = Vec::new();
+        for &t in &carved.tets {
+            let v = cdt.dt.mesh.verts(t);
+            if !on
+                .of(v[0])
+                .iter()
+                .any(|&f| (1..4).all(|i| on_facet(v[i], f)))
+            {
+                continue;
+            }
+            let faces: [[VertexId; 3]; 4] =
+                crate::mesh::FACE_VERTS.map(|fv| face_key([v[fv[0]], v[fv[1]], v[fv[2]]]));
+            let Some(facet) = faces.iter().find_map(|k| cdt.subfaces.get(k).copied()) else {
+                continue;
+            };
+            if !v.iter().all(|&x| on_facet(x, facet)) {
+                continue;
+            }
+            let (sub, free): (Vec<[VertexId; 3]>, Vec<[VertexId; 3]>) =
+                faces.iter().partition(|k| cdt.subfaces.contains_key(*k));
+            // The shim can leave the domain only if nothing behind its subfaces is in it.
+            let kept_behind_sub = sub.iter().any(|k: &[VertexId; 3]| {
+                let i = (0..4).find(|&i| !k.contains(&v[i])).unwrap_or(0);
+                kept[cdt.dt.mesh.adj(crate::mesh::FaceRef::new(t, i)).tet() as usize]
+            });
+            if debug() {
+                eprintln!(
+                    "shim {v:?} facet {facet} free {} kept_behind_sub {kept_behind_sub}",
+                    free.len()
+                );
+            }
+            if opts.keep_hull && kept_behind_sub {
+                // With the hull kept, both sides of every polygon stay; a Steiner point
+                // at a subface does not help slivers outside the polygon, so leave them.
+                continue;
+            }
+            // Edges between the subfaces disappear with the swap. If one is a
+            // subsegment, the shim stays: splitting the subsegment only makes smaller
+            // shims of the same shape (a step or dent at a segment), so a flat one is
+            // left to a free vertex (see `slivers`).
+            let lost_subsegment = crate::mesh::EDGE_VERTS.iter().any(|&(i, j)| {
+                let (a, b) = edge_key(v[i], v[j]);
+                let in_faces = |fs: &[[VertexId; 3]]| {
+                    fs.iter()
+                        .filter(|k| k.contains(&a) && k.contains(&b))
+                        .count()
+                };
+                in_faces(&sub) == 2 && in_faces(&free) == 0 && cdt.subsegs.contains_key(&(a, b))
+            });
+            if lost_subsegment {
+                continue;
+            }
+            if free.is_empty() || kept_behind_sub {
+                // Both sides of the polygon keep the shim: only a Steiner point helps.
+                let f = sub[0].map(|x| cdt.dt.points[x as usize]);
+                let c: Point = std::array::from_fn(|k| (f[0][k] + f[1][k] + f[2][k]) / 3.0);
+                needs.push((facet as usize, c));
+                continue;
+            }
+            for k in &sub {
+                cdt.subfaces.remove(k);
+            }
+            for k in free {
+                cdt.subfaces.insert(k, facet);
+            }
+            swapped.push(t);
+        }
+        // Swaps can uncover shims stacked behind others: Steiner points are only for
+        // what no swap can remove.
+        if swapped.is_empty() {
+            return (needs, Some(carved));
+        }
+        if !opts.keep_hull && plc.regions.is_empty() {
+            // A swap opens the shim's faces towards removed tets and closes its others:
+            // the shim is removed, and nothing else changes, so no new flood is needed
+            // (a full one cost 5% of a large model's time). With the hull kept,
+            // nothing floods in from outside; region floods could have passed through
+            // the shim: in those cases the carving starts afresh.
+            swapped.sort_unstable();
+            carved.tets.retain(|t| swapped.binary_search(t).is_err());
+            carved.attributes = vec![0.0; carved.tets.len()];
+            debug_assert_eq!(
+                carved.tets,
+                carve(cdt, &plc.holes, &plc.regions, opts.keep_hull).tets,
+                "a shim swap changed the carving beyond its shim"
+            );
+        } else {
+            carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
+        }
+    }
+    (Vec::new(), None)
+}
+
+/// Groups missing triangles into regions connected through shared edges that are not
+/// subsegments.
+fn regions_of(
+    missing: &[[VertexId; 3]],
+    subsegs: &FxHashMap<(VertexId, VertexId), i32>,
+) -> Vec<Vec<[VertexId; 3]>> {
+    let by_edge = triangles_by_edge(missing);
+    let mut comp = vec![usize::MAX; missing.len()];
+    let mut out = Vec::new();
+    for s in 0..missing.len() {
+        if comp[s] != usize::MAX {
+            continue;
+        }
+        comp[s] = out.len();
+        let mut region = Vec::new();
+        let mut stack = vec![s];
+        while let Some(i) = stack.pop() {
+            region.push(missing[i]);
+            let t = missing[i];
+            for k in 0..3 {
+                let e = edge_key(t[k], t[(k + 1) % 3]);
+                if subsegs.contains_key(&e) {
+                    continue;
+                }
+                for &j in &by_edge[&e] {
+                    if comp[j] == usize::MAX {
+                        comp[j] = out.len();
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        out.push(region);
+    }
+    out
+}
