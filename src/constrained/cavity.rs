@@ -228,8 +228,36 @@ pub fn insert_region(
             "a cavity side was not triangulated".into(),
         ));
     };
+    let counts = (crossing, enlarged);
+    replace_cavity(
+        cdt,
+        &region,
+        facet,
+        normal,
+        &cavity,
+        [&top_side, &bottom_side],
+        counts,
+    )
+}
+
+/// Replaces the `cavity` of region `region` of `facet` by the new tets of its two sides
+/// (their faces and triangulations), once they are checked: a shim (four vertices on the
+/// polygon) asks for a Steiner point, a subsegment inside the cavity that the new tets
+/// lack for its split, and losing a vertex is an error. The subfaces of other facets
+/// that the new tets do not have are returned as lost. `counts`: the crossing tets and
+/// those added by enlargement, for the figures.
+fn replace_cavity(
+    cdt: &mut Cdt,
+    region: &Region,
+    facet: u32,
+    normal: [f64; 3],
+    cavity: &[TetId],
+    [top_side, bottom_side]: [&(Vec<CavFace>, SideDt); 2],
+    (crossing, enlarged): (usize, usize),
+) -> Result<Outcome, MeshError> {
+    let tris = &region.tris[..];
     let mut new_tets = Vec::new();
-    for (faces, sdt) in [&top_side, &bottom_side] {
+    for (faces, sdt) in [top_side, bottom_side] {
         for v in sdt.inside(faces)? {
             if v.iter().all(|x| region.verts.contains(x)) {
                 // A shim tet: four vertices on the polygon.
@@ -244,7 +272,7 @@ pub fn insert_region(
     for &x in new_tets.iter().flatten() {
         kept_verts[x as usize] = true;
     }
-    for &t in &cavity {
+    for &t in cavity {
         let lost = cdt
             .dt
             .mesh
@@ -262,7 +290,7 @@ pub fn insert_region(
     // Only the few subsegments among the cavity's edges are looked up in the new tets.
     let mut stake_order: Vec<(VertexId, VertexId)> = Vec::new();
     let mut kept_edge: FxHashMap<(VertexId, VertexId), bool> = FxHashMap::default();
-    for &t in &cavity {
+    for &t in cavity {
         let v = cdt.dt.mesh.verts(t);
         for &(i, j) in &EDGES {
             let e = (v[i].min(v[j]), v[i].max(v[j]));
@@ -285,7 +313,7 @@ pub fn insert_region(
     }
     // Subfaces among the faces of the deleted tets may not survive the new triangulation.
     let mut at_risk: Vec<[VertexId; 3]> = Vec::new();
-    for &t in &cavity {
+    for &t in cavity {
         for i in 0..4 {
             let v = cdt.dt.mesh.face_verts(t, i);
             let key = face_key(v);
@@ -294,7 +322,7 @@ pub fn insert_region(
             }
         }
     }
-    graft(cdt, &cavity, &top_side.0, &bottom_side.0, &new_tets)?;
+    graft(cdt, cavity, &top_side.0, &bottom_side.0, &new_tets)?;
     let mut lost = Vec::new();
     at_risk.sort_unstable();
     at_risk.dedup();

@@ -260,70 +260,31 @@ pub fn mesh_plc_with_progress(
     opts: &PlcOptions,
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
-    // The PLC's preparation and the first attempt's Delaunay tetrahedralization do not
-    // depend on each other: they run on two cores.
-    // An open surface is found once prepared: the Delaunay stage then stops early.
     progress(Stage::Delaunay);
-    let open = AtomicBool::new(false);
-    let (prepared, first_dt) = std::thread::scope(|s| {
-        let preparing = s.spawn(|| -> Result<_, Error> {
-            let base = prepare(plc, opts.merge);
-            if let Some(t) = &opts.wake_when_prepared {
-                t.unpark();
-            }
-            let refused = match &base {
-                Ok(b) => !opts.keep_hull && enclosure::open_boundary(plc, b).is_some(),
-                Err(_) => true,
-            };
-            if refused {
-                open.store(true, Ordering::Relaxed);
-            }
-            let base = base?;
-            // Flat tets are judged on the facets as merged by default, whatever the
-            // switches and the splitting of groups below did.
-            let all_merged = if opts.merge {
-                None
-            } else {
-                Some(prepare(plc, true)?)
-            };
-            Ok((base, all_merged))
-        });
-        let t0 = Instant::now();
-        let dt =
-            Delaunay::build_until(&plc.points, &open).map(|b| (b.dt, t0.elapsed().as_secs_f64()));
-        let prepared = preparing
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (prepared, dt)
-    });
-    let (base, all_merged) = prepared?;
+    let ((base, all_merged), first_dt) = prepare_beside_delaunay(plc, opts)?;
     let merged = all_merged.as_ref().unwrap_or(&base);
     // `base` with the groups that could not be triangulated in one plane kept apart.
     let mut split: Option<PreparedPlc> = None;
     let prep = &base;
-    // The message lists the boundary edges in the input's own terms.
-    if open.load(Ordering::Relaxed) {
-        return Err(crate::error::InputError::Invalid {
-            file: plc.source.clone(),
-            msg: crate::precheck::empty_domain_message(plc),
-        }
-        .into());
-    }
-    let mut first_dt = Some(first_dt?);
+    let mut first_dt = Some(first_dt);
     // Input facets kept out of merging because their merged group could not be
     // triangulated in one plane.
     let mut keep_apart: Vec<usize> = Vec::new();
-    let mut warnings = Vec::new();
-    for &(dup, kept) in &prep.duplicates {
-        warnings.push(format!(
-            "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
-            dup as usize + plc.first_index,
-            kept as usize + plc.first_index,
-            plc.points[kept as usize][0],
-            plc.points[kept as usize][1],
-            plc.points[kept as usize][2]
-        ));
-    }
+    let mut warnings: Vec<String> = prep
+        .duplicates
+        .iter()
+        .map(|&(dup, kept)| {
+            let p = plc.points[kept as usize];
+            format!(
+                "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
+                dup as usize + plc.first_index,
+                kept as usize + plc.first_index,
+                p[0],
+                p[1],
+                p[2]
+            )
+        })
+        .collect();
     let mut stats = PlcStats {
         inserter: opts.inserter,
         input_points: plc.points.len(),
@@ -495,18 +456,8 @@ pub fn mesh_plc_with_progress(
     let (flat, first) = built.flat_left;
     stats.flat_tets_left = flat;
     if let Some(f) = first.filter(|_| flat > 0) {
-        let why = if stats.free_searches_cut > 0 {
-            "which the search for free Steiner points, cut short at its bound on work (a \
-             vertex far out of the model's scale makes it long), did not remove"
-        } else {
-            "which no free Steiner point could remove"
-        };
-        warnings.push(format!(
-            "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
-             {}: steps or dents of facets that are not flat, {why} (checks for shim tets flag \
-             them)",
-            facet_name(plc, &merged.facets[f as usize])
-        ));
+        let facet = facet_name(plc, &merged.facets[f as usize]);
+        warnings.push(flat_tets_warning(flat, &facet, stats.free_searches_cut > 0));
     }
     let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
     Ok(PlcMesh {
@@ -514,6 +465,77 @@ pub fn mesh_plc_with_progress(
         stats,
         warnings,
     })
+}
+
+/// The PLC as meshed, and (without merging) as prepared with every group merged.
+type Prepared = (PreparedPlc, Option<PreparedPlc>);
+
+/// The PLC prepared (and, without merging, prepared again with every coplanar group
+/// merged, on which flat tets are judged) and its first Delaunay tetrahedralization with
+/// its time: they do not depend on each other, and run on two cores. An open surface is
+/// found once prepared (the Delaunay stage then stops early) and refused.
+fn prepare_beside_delaunay(
+    plc: &Plc,
+    opts: &PlcOptions,
+) -> Result<(Prepared, (Delaunay, f64)), Error> {
+    let open = AtomicBool::new(false);
+    let (prepared, first_dt) = std::thread::scope(|s| {
+        let preparing = s.spawn(|| -> Result<_, Error> {
+            let base = prepare(plc, opts.merge);
+            if let Some(t) = &opts.wake_when_prepared {
+                t.unpark();
+            }
+            let refused = match &base {
+                Ok(b) => !opts.keep_hull && enclosure::open_boundary(plc, b).is_some(),
+                Err(_) => true,
+            };
+            if refused {
+                open.store(true, Ordering::Relaxed);
+            }
+            let base = base?;
+            // Flat tets are judged on the facets as merged by default, whatever the
+            // switches and the splitting of groups did.
+            let all_merged = if opts.merge {
+                None
+            } else {
+                Some(prepare(plc, true)?)
+            };
+            Ok((base, all_merged))
+        });
+        let t0 = Instant::now();
+        let dt =
+            Delaunay::build_until(&plc.points, &open).map(|b| (b.dt, t0.elapsed().as_secs_f64()));
+        let prepared = preparing
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (prepared, dt)
+    });
+    let prepared = prepared?;
+    // The message lists the boundary edges in the input's own terms.
+    if open.load(Ordering::Relaxed) {
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::empty_domain_message(plc),
+        }
+        .into());
+    }
+    Ok((prepared, first_dt?))
+}
+
+/// The warning for `flat` flat tets left on facets, the first on `facet` (`cut`: the
+/// search for free points stopped at its bound on work).
+fn flat_tets_warning(flat: usize, facet: &str, cut: bool) -> String {
+    let why = if cut {
+        "which the search for free Steiner points, cut short at its bound on work (a \
+         vertex far out of the model's scale makes it long), did not remove"
+    } else {
+        "which no free Steiner point could remove"
+    };
+    format!(
+        "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
+         {facet}: steps or dents of facets that are not flat, {why} (checks for shim tets flag \
+         them)"
+    )
 }
 
 /// The state of the constructions that follow one leaving a few thick tets on facets.
