@@ -228,7 +228,6 @@ pub fn insert_region(
             "a cavity side was not triangulated".into(),
         ));
     };
-    let counts = (crossing, enlarged);
     replace_cavity(
         cdt,
         &region,
@@ -236,7 +235,7 @@ pub fn insert_region(
         normal,
         &cavity,
         [&top_side, &bottom_side],
-        counts,
+        (crossing, enlarged),
     )
 }
 

@@ -1,10 +1,10 @@
 //! Flat tets whose four vertices all lie on one facet yet survive carving. They span a
 //! step or a dent of a facet that is not flat (a merged group of nearly coplanar
 //! polygons, or a thin wedge between two of them), where both sides agree on the
-//! polygon's triangles, so [`super::construction::resolve_shims`] has nothing to swap. A Steiner point
-//! on the facet cannot help: whatever it forms with the facet's vertices is as flat. A
-//! free vertex inside the tet's circumsphere, well off the facet and inside the domain,
-//! removes the tet from the CDT instead.
+//! polygon's triangles, so [`super::construction::resolve_shims`] has nothing to swap.
+//! A Steiner point on the facet cannot help: whatever it forms with the facet's vertices
+//! is as flat. A free vertex inside the tet's circumsphere, well off the facet and inside
+//! the domain, removes the tet from the CDT instead.
 
 use super::cdt::Cdt;
 use super::prepare::{newell_normal, PreparedPlc};
