@@ -257,7 +257,15 @@ fn replace_cavity(
     let tris = &region.tris[..];
     let mut new_tets = Vec::new();
     for (faces, sdt) in [top_side, bottom_side] {
-        for v in sdt.inside(faces)? {
+        let Some(inside) = sdt.inside(faces)? else {
+            // The sides were told apart wrongly around a polygon far from flat: a point
+            // on it makes its pieces flatter.
+            if super::debug() {
+                eprintln!("facet {facet}: a cavity side is not closed");
+            }
+            return Ok(Outcome::NeedsSteiner(largest_centroid(cdt, tris)));
+        };
+        for v in inside {
             if v.iter().all(|x| region.verts.contains(x)) {
                 // A shim tet: four vertices on the polygon.
                 let f = [v[0], v[1], v[2]];
@@ -1134,8 +1142,9 @@ impl SideDt {
 
     /// The tets inside the side bounded by `faces` (each seen with the side on its
     /// positive side), as mesh vertex ids: a flood fill from the faces' inner tets that
-    /// never crosses them.
-    fn inside(&self, faces: &[CavFace]) -> Result<Vec<[VertexId; 4]>, MeshError> {
+    /// never crosses them. `None` if the faces do not close the side (the flood reaches
+    /// the hull).
+    fn inside(&self, faces: &[CavFace]) -> Result<Option<Vec<[VertexId; 4]>>, MeshError> {
         let mut wall: FxHashSet<FaceRef> =
             FxHashSet::with_capacity_and_hasher(2 * faces.len(), Default::default());
         let mut stack = Vec::new();
@@ -1153,7 +1162,7 @@ impl SideDt {
         }
         while let Some(t) = stack.pop() {
             if self.dt.mesh.is_ghost(t) {
-                return Err(MeshError::Internal("a cavity side is not closed".into()));
+                return Ok(None);
             }
             for i in 0..4 {
                 let f = FaceRef::new(t, i);
@@ -1168,10 +1177,11 @@ impl SideDt {
         }
         let mut out: Vec<TetId> = inside.into_iter().collect();
         out.sort_unstable();
-        Ok(out
-            .into_iter()
-            .map(|t| self.dt.mesh.verts(t).map(|x| self.global[x as usize]))
-            .collect())
+        Ok(Some(
+            out.into_iter()
+                .map(|t| self.dt.mesh.verts(t).map(|x| self.global[x as usize]))
+                .collect(),
+        ))
     }
 }
 
