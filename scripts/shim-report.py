@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """What the shims that validate_mesh.py counts in a mesh are made of.
 
-usage: scripts/shim-report.py INPUT OUT_PREFIX [--list] [--tools DIR]
+usage: scripts/shim-report.py INPUT OUT_PREFIX [--list] [--spheres] [--tools DIR]
 
 The referee (../shared/tools/validate_mesh.py, imported from DIR, by default the first
 of ../shared/tools and /work/shared/tools that has it) merges edge-adjacent polygons
@@ -16,7 +16,12 @@ This script finds the same shims and sorts each vertex into one of three kinds:
 
 It prints how many shims there are of each composition, then the heights of the
 foreign vertices above the group's plane as fractions of the slab's half-thickness.
-With --list it also prints every shim. The figures on attene_cdt/112544.off in
+With --list it also prints every shim. With --spheres it tells, for each shim with a face
+on the mesh boundary, which side of that face its circumsphere's centre lies on: beyond
+the surface (a "lens": inside the domain the sphere is only as thick as its reach there,
+so no point well off the slab can remove the tet; the surface points must change) or in
+the domain (a free point inside the sphere removes it), with the sphere's reach into the
+domain against the slab's half-thickness. The figures on attene_cdt/112544.off in
 docs/112544.md come from this script. It needs numpy.
 """
 import os
@@ -125,6 +130,40 @@ def find_shims(vm, ipts, polys, facet_of, P, T):
     return found
 
 
+def sphere_sides(P, T, found):
+    """For each shim of `found` with a face on the mesh boundary: whether its circumsphere's
+    centre lies beyond that face (outside the domain), and how far the sphere reaches into
+    the domain from the face's plane. None for shims without a boundary face."""
+    faces = {}
+    for t, tv in enumerate(T.tolist()):
+        for k in range(4):
+            key = tuple(sorted(tv[:k] + tv[k + 1:]))
+            faces[key] = faces.get(key, 0) + 1
+    out = []
+    for _gi, tv, _kind, _h in found:
+        side = None
+        for k in range(4):
+            f = sorted(tv[:k] + tv[k + 1:])
+            if faces.get(tuple(f)) != 1:
+                continue
+            a, b, c = P[f]
+            n = np.cross(b - a, c - a)
+            n /= np.linalg.norm(n)
+            if (P[tv[k]] - a) @ n < 0:
+                n = -n  # towards the domain: the tet's own fourth vertex
+            q = P[tv]
+            try:
+                centre = np.linalg.solve(2 * (q[1:] - q[0]), (q[1:] ** 2).sum(1) - (q[0] ** 2).sum())
+            except np.linalg.LinAlgError:
+                break
+            radius = np.linalg.norm(centre - q[0])
+            height = (centre - a) @ n
+            side = (height < 0, radius + height)
+            break
+        out.append(side)
+    return out
+
+
 def main(argv):
     vm = load_referee(argv)
     args, skip = [], False
@@ -156,6 +195,17 @@ def main(argv):
         q = np.percentile(heights, [0, 25, 50, 75, 100])
         print(f"foreign vertices: {len(heights)}; height / slab half-thickness: "
               f"min {q[0]:.2f}, quartiles {q[1]:.2f} {q[2]:.2f} {q[3]:.2f}, max {q[4]:.2f}")
+    if "--spheres" in argv:
+        sides = sphere_sides(P, T, found)
+        lens = [r for s in sides if s and s[0] for r in [s[1]]]
+        inside = [r for s in sides if s and not s[0] for r in [s[1]]]
+        print(f"with a boundary face: {len(lens) + len(inside)}; centre beyond the surface "
+              f"(lens): {len(lens)}, in the domain: {len(inside)}")
+        for name, rs in (("lens", lens), ("in the domain", inside)):
+            if rs:
+                q = np.percentile(rs, [0, 50, 100])
+                print(f"  {name}: reach into the domain min {q[0]:.2e}, median {q[1]:.2e}, "
+                      f"max {q[2]:.2e}")
 
 
 if __name__ == "__main__":
