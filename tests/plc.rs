@@ -586,7 +586,8 @@ fn flat_tets_get_free_points_inserted_into_the_cdt() {
 fn flat_tets_left_on_a_facet_are_counted_and_reported() {
     // anchor.off's flat tets need a free point. With -S leaving no room for one, the flat
     // tet stays: the run still succeeds, but says so (a warning, and the figure), where
-    // it used to say nothing; with room, nothing is left and nothing is said.
+    // it used to say nothing, and `--check` fails it; with room, nothing is left and
+    // nothing is said.
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/anchor.off");
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("s.json");
@@ -625,6 +626,10 @@ fn flat_tets_left_on_a_facet_are_counted_and_reported() {
             )),
             "-S{limit}: {err}"
         );
+        // The mesh's own check finds it too, as a shim, and fails the run.
+        let (code, err) = run(&m, &prefix, &["-p", &format!("-S{limit}"), "--check"]);
+        assert_eq!(code, 1, "-S{limit} --check: {err}");
+        assert!(err.contains("is a shim"), "-S{limit} --check: {err}");
         seen = true;
         break;
     }

@@ -533,8 +533,8 @@ fn flat_tets_warning(flat: usize, facet: &str, cut: bool) -> String {
     };
     format!(
         "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
-         {facet}: steps or dents of facets that are not flat, {why} (checks for shim tets flag \
-         them)"
+         {facet}: steps or dents of facets that are not flat, {why} (checks for shim tets, \
+         `--check` among them, flag them)"
     )
 }
 

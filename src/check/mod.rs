@@ -5,7 +5,13 @@
 //! shared by at most two tets lying on opposite sides, that the neighbour table agrees,
 //! that the boundary is a closed locally convex surface enclosing the tets' volume with
 //! every input point used (so the tets tile the convex hull), and that every face is
-//! locally Delaunay under the symbolic perturbation.
+//! locally Delaunay under the symbolic perturbation. For a PLC it verifies instead that
+//! every unconstrained face is locally Delaunay, that the constraints are in the mesh and
+//! the boundary lies on them, that no input point is lost inside the mesh, and that no
+//! shim tet survives (`shims.rs`: a flat tet with all four vertices on one facet, as the
+//! shared referee counts them).
+
+mod shims;
 
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
 use crate::mesh::{EDGE_VERTS, FACE_VERTS};
@@ -129,6 +135,7 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
     if mesh.plc_mode {
         check_constraints(plc, mesh, &subfaces, &boundary, &mut pr);
         check_points_kept(plc, mesh, &mut pr);
+        check_shims(plc, mesh, &mut pr);
     } else {
         check_vertices_used(plc, mesh, &mut pr);
     }
@@ -252,6 +259,21 @@ fn check_constraints(
                 }
             }
         }
+    }
+}
+
+/// No shim tet may survive: a flat tet whose four vertices lie on one (merged) facet.
+fn check_shims(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
+    let rep = crate::precheck::representatives(&plc.points);
+    let found = shims::shims(plc, mesh, &rep);
+    let base = mesh.first_index;
+    for &(t, facet) in &found {
+        pr.push(format!(
+            "tet {} {:?} is a shim: flat, with all four vertices on facet {} (as merged)",
+            t + base,
+            shift(&mesh.tets[t], base),
+            facet + base
+        ));
     }
 }
 
@@ -771,6 +793,62 @@ mod tests {
         lost.points.push(full.points[8]);
         let e = check_mesh(&full, &lost).unwrap_err().join("\n");
         assert!(e.contains("input point 8 lies in tet"), "{e}");
+    }
+
+    #[test]
+    fn a_shim_fails() {
+        // A square pyramid whose base is bent by 1e-4: the mesher's mesh passes, and the
+        // same domain with a flat tet of the four base corners beneath two others fails.
+        let mut plc = Plc::from_points(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, -1e-4],
+                [0.5, 0.5, 1.0],
+            ],
+            0,
+        );
+        let polygons = [
+            vec![0, 1, 2, 3],
+            vec![0, 1, 4],
+            vec![1, 2, 4],
+            vec![2, 3, 4],
+            vec![3, 0, 4],
+        ];
+        plc.facets = polygons
+            .into_iter()
+            .map(|p| crate::plc::Facet {
+                polygons: vec![p],
+                ..Default::default()
+            })
+            .collect();
+        let opts = Options {
+            plc: true,
+            ..Default::default()
+        };
+        let mut m = crate::tetrahedralize(&plc, &opts).unwrap().mesh;
+        check_mesh(&plc, &m).unwrap();
+        m.tets = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 2, 3, 4]]
+            .into_iter()
+            .map(|mut t| {
+                let p = t.map(|v| m.points[v as usize]);
+                if orient3d(&p[0], &p[1], &p[2], &p[3]) < 0.0 {
+                    t.swap(0, 1);
+                }
+                t
+            })
+            .collect();
+        m.neighbors.clear();
+        // The base's triangles are now the lower pair, under the flat tet.
+        m.subfaces.retain(|(f, _)| f.contains(&4));
+        m.subfaces.extend([([0, 1, 3], 0), ([1, 2, 3], 0)]);
+        let e = check_mesh(&plc, &m).unwrap_err();
+        assert_eq!(e.len(), 1, "{e:?}");
+        assert!(
+            e[0].starts_with("tet 0 ") && e[0].contains("is a shim"),
+            "{e:?}"
+        );
     }
 
     #[test]
