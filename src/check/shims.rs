@@ -9,6 +9,7 @@
 use crate::geom::{orient3d, Point};
 use crate::output::MeshOut;
 use crate::plc::Plc;
+use crate::precheck::bvh::{Aabb, Bvh};
 use rustc_hash::FxHashMap;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed.
@@ -115,8 +116,10 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
     if groups.is_empty() {
         return Vec::new();
     }
-    // Steiner points: the merged facets whose box and slab hold them, found by a grid.
-    let grid = BoxGrid::new(&groups);
+    // Steiner points: the merged facets whose box and slab hold them, found by a
+    // bounding-volume hierarchy (a fan of long needles has many boxes across the model).
+    let boxes: Vec<Aabb> = groups.iter().map(|g| [g.lo, g.hi]).collect();
+    let bvh = Bvh::build(&boxes);
     let mut steiner: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     let on = |v: u32, steiner: &mut FxHashMap<u32, Vec<u32>>| -> Vec<u32> {
         if (v as usize) < n_input {
@@ -126,11 +129,14 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
             .entry(v)
             .or_insert_with(|| {
                 let p = &pts[v as usize];
-                grid.near(p)
-                    .iter()
-                    .copied()
-                    .filter(|&g| groups[g as usize].holds(p))
-                    .collect()
+                let mut near = Vec::new();
+                bvh.query(&boxes, &[*p, *p], |g| {
+                    if groups[g].holds(p) {
+                        near.push(g as u32);
+                    }
+                });
+                near.sort_unstable();
+                near
             })
             .clone()
     };
@@ -264,57 +270,6 @@ fn is_flat(p: &[Point; 4]) -> bool {
         }
     }
     orient3d(&p[0], &p[1], &p[2], &p[3]).abs() / 6.0 <= FLAT * l2 * l2.sqrt()
-}
-
-/// A uniform grid over the merged facets' boxes.
-struct BoxGrid {
-    lo: Point,
-    cell: f64,
-    cells: FxHashMap<[i64; 3], Vec<u32>>,
-}
-
-impl BoxGrid {
-    fn new(groups: &[Group]) -> Self {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for g in groups {
-            for k in 0..3 {
-                lo[k] = lo[k].min(g.lo[k]);
-                hi[k] = hi[k].max(g.hi[k]);
-            }
-        }
-        let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-        let per_side = (groups.len() as f64).cbrt().ceil().max(1.0);
-        let cell = if size > 0.0 && size.is_finite() {
-            size / per_side
-        } else {
-            1.0
-        };
-        let mut grid = BoxGrid {
-            lo,
-            cell,
-            cells: FxHashMap::default(),
-        };
-        for (gi, g) in groups.iter().enumerate() {
-            let (a, b) = (grid.key(&g.lo), grid.key(&g.hi));
-            for i in a[0]..=b[0] {
-                for j in a[1]..=b[1] {
-                    for l in a[2]..=b[2] {
-                        grid.cells.entry([i, j, l]).or_default().push(gi as u32);
-                    }
-                }
-            }
-        }
-        grid
-    }
-
-    fn key(&self, p: &Point) -> [i64; 3] {
-        std::array::from_fn(|k| ((p[k] - self.lo[k]) / self.cell).floor() as i64)
-    }
-
-    /// The merged facets whose boxes may hold `p`.
-    fn near(&self, p: &Point) -> &[u32] {
-        self.cells.get(&self.key(p)).map_or(&[], |v| v.as_slice())
-    }
 }
 
 #[cfg(test)]
