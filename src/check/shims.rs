@@ -6,7 +6,8 @@
 //! the shared referee's measure, kept apart from the mesher's own search so that the
 //! two check each other.
 
-use crate::geom::{orient3d, Point};
+use crate::constrained::prepare::{dedup_ring, newell_normal, Dsu};
+use crate::geom::{bounding_box, dot, orient3d, Point};
 use crate::output::MeshOut;
 use crate::plc::Plc;
 use crate::precheck::bvh::{Aabb, Bvh};
@@ -42,27 +43,23 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
     let pts = &mesh.points;
     let n_input = plc.points.len();
     // The polygons, as rings of representatives without repeats, with their facets.
-    let mut polys: Vec<(usize, Vec<u32>)> = Vec::new();
-    for (fi, f) in plc.facets.iter().enumerate() {
-        for poly in &f.polygons {
-            let mut ring: Vec<u32> = Vec::with_capacity(poly.len());
-            for &v in poly {
-                let r = rep[v as usize];
-                if ring.last() != Some(&r) {
-                    ring.push(r);
-                }
-            }
-            while ring.len() > 1 && ring.first() == ring.last() {
-                ring.pop();
-            }
-            polys.push((fi, ring));
-        }
-    }
+    let polys: Vec<(usize, Vec<u32>)> = plc
+        .facets
+        .iter()
+        .enumerate()
+        .flat_map(|(fi, f)| {
+            f.polygons.iter().map(move |poly| {
+                let reps: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
+                (fi, dedup_ring(&reps))
+            })
+        })
+        .collect();
     let groups_of = merge_coplanar(pts, &polys);
     let diag = diagonal(pts);
     let mut groups: Vec<Group> = Vec::new();
-    // For each input vertex, the merged facets it is a vertex of.
-    let mut of_vertex: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    // For each mesh vertex, the merged facets it lies on (increasing): input vertices by
+    // their polygons, Steiner points below by the facets' slabs and boxes.
+    let mut on: Vec<Vec<u32>> = vec![Vec::new(); pts.len()];
     for members in groups_of {
         let rings: Vec<&(usize, Vec<u32>)> = members
             .iter()
@@ -71,7 +68,7 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
             .collect();
         let Some(largest) = rings
             .iter()
-            .map(|(_, r)| newell(pts, r))
+            .map(|(_, r)| newell_normal(pts, r))
             .max_by(|a, b| norm(a).total_cmp(&norm(b)))
         else {
             continue;
@@ -102,7 +99,7 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
         }
         let g = groups.len() as u32;
         for &v in &verts {
-            of_vertex.entry(v).or_default().push(g);
+            on[v as usize].push(g);
         }
         groups.push(Group {
             normal,
@@ -120,35 +117,22 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
     // bounding-volume hierarchy (a fan of long needles has many boxes across the model).
     let boxes: Vec<Aabb> = groups.iter().map(|g| [g.lo, g.hi]).collect();
     let bvh = Bvh::build(&boxes);
-    let mut steiner: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    let on = |v: u32, steiner: &mut FxHashMap<u32, Vec<u32>>| -> Vec<u32> {
-        if (v as usize) < n_input {
-            return of_vertex.get(&v).cloned().unwrap_or_default();
-        }
-        steiner
-            .entry(v)
-            .or_insert_with(|| {
-                let p = &pts[v as usize];
-                let mut near = Vec::new();
-                bvh.query(&boxes, &[*p, *p], |g| {
-                    if groups[g].holds(p) {
-                        near.push(g as u32);
-                    }
-                });
-                near.sort_unstable();
-                near
-            })
-            .clone()
-    };
-    let mut found = Vec::new();
-    for (t, tv) in mesh.tets.iter().enumerate() {
-        let mut common = on(tv[0], &mut steiner);
-        for &v in &tv[1..] {
-            if common.is_empty() {
-                break;
+    for (v, p) in pts.iter().enumerate().skip(n_input) {
+        bvh.query(&boxes, &[*p, *p], |g| {
+            if groups[g].holds(p) {
+                on[v].push(g as u32);
             }
-            let other = on(v, &mut steiner);
-            common.retain(|g| other.contains(g));
+        });
+        on[v].sort_unstable();
+    }
+    let mut found = Vec::new();
+    let mut common = Vec::new();
+    for (t, tv) in mesh.tets.iter().enumerate() {
+        common.clear();
+        common.extend_from_slice(&on[tv[0] as usize]);
+        for &v in &tv[1..] {
+            let here = &on[v as usize];
+            common.retain(|g| here.binary_search(g).is_ok());
         }
         let Some(&g) = common.first() else {
             continue;
@@ -163,25 +147,12 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
 
 /// Groups the polygons (by index) into merged facets.
 fn merge_coplanar(pts: &[Point], polys: &[(usize, Vec<u32>)]) -> Vec<Vec<usize>> {
-    let mut parent: Vec<usize> = (0..polys.len()).collect();
-    fn find(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    fn union(parent: &mut [usize], a: usize, b: usize) {
-        let (ra, rb) = (find(parent, a), find(parent, b));
-        if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
-        }
-    }
+    let mut dsu = Dsu((0..polys.len()).collect());
     let mut first_of_facet: FxHashMap<usize, usize> = FxHashMap::default();
     let mut users: FxHashMap<(u32, u32), Vec<usize>> = FxHashMap::default();
     for (i, (fi, ring)) in polys.iter().enumerate() {
         let j = *first_of_facet.entry(*fi).or_insert(i);
-        union(&mut parent, i, j);
+        dsu.union(i, j);
         let n = ring.len();
         let edges = match n {
             0 | 1 => 0,
@@ -200,7 +171,7 @@ fn merge_coplanar(pts: &[Point], polys: &[(usize, Vec<u32>)]) -> Vec<Vec<usize>>
         if r.len() < 3 {
             return None;
         }
-        let n = newell(pts, r);
+        let n = newell_normal(pts, r);
         let l = norm(&n);
         (l > 0.0).then(|| n.map(|x| x / l))
     };
@@ -210,49 +181,28 @@ fn merge_coplanar(pts: &[Point], polys: &[(usize, Vec<u32>)]) -> Vec<Vec<usize>>
     for (_, us) in edges {
         if let [a, b] = us[..] {
             if let (Some(x), Some(y)) = (unit(a), unit(b)) {
-                if (x[0] * y[0] + x[1] * y[1] + x[2] * y[2]).abs() >= cos_tol {
-                    union(&mut parent, a, b);
+                if dot(&x, &y).abs() >= cos_tol {
+                    dsu.union(a, b);
                 }
             }
         }
     }
     let mut groups: FxHashMap<usize, Vec<usize>> = FxHashMap::default();
     for i in 0..polys.len() {
-        groups.entry(find(&mut parent, i)).or_default().push(i);
+        groups.entry(dsu.find(i)).or_default().push(i);
     }
     let mut out: Vec<Vec<usize>> = groups.into_values().collect();
     out.sort_unstable();
     out
 }
 
-/// The Newell normal of a ring (twice its vector area).
-fn newell(pts: &[Point], ring: &[u32]) -> Point {
-    let mut n = [0.0; 3];
-    for k in 0..ring.len() {
-        let (p, q) = (
-            pts[ring[k] as usize],
-            pts[ring[(k + 1) % ring.len()] as usize],
-        );
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-    }
-    n
-}
-
 fn norm(v: &Point) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+    dot(v, v).sqrt()
 }
 
 /// The diagonal of the points' bounding box (1 for an empty or degenerate set).
 fn diagonal(pts: &[Point]) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in pts {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let [lo, hi] = bounding_box(pts);
     let d = norm(&std::array::from_fn(|k| hi[k] - lo[k]));
     if d > 0.0 && d.is_finite() {
         d

@@ -66,7 +66,7 @@ struct Poly {
 }
 
 /// Drops repeated consecutive vertices, also across the wrap.
-fn dedup_ring(poly: &[u32]) -> Vec<u32> {
+pub(crate) fn dedup_ring(poly: &[u32]) -> Vec<u32> {
     let mut out: Vec<u32> = Vec::with_capacity(poly.len());
     for &v in poly {
         if out.last() != Some(&v) {
@@ -114,20 +114,20 @@ pub(crate) fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
 }
 
 /// Union-find with path halving.
-struct Dsu(Vec<usize>);
+pub(crate) struct Dsu(pub(crate) Vec<usize>);
 
 /// One use of an edge (sorted vertex pair) by a polygon (its index).
 type EdgeUse = ((u32, u32), u32);
 
 impl Dsu {
-    fn find(&mut self, mut i: usize) -> usize {
+    pub(crate) fn find(&mut self, mut i: usize) -> usize {
         while self.0[i] != i {
             self.0[i] = self.0[self.0[i]];
             i = self.0[i];
         }
         i
     }
-    fn union(&mut self, a: usize, b: usize) {
+    pub(crate) fn union(&mut self, a: usize, b: usize) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             // Keep the lower index as the root: deterministic and order-friendly.
