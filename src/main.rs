@@ -14,6 +14,7 @@ use std::ffi::OsString;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
+use tetcdt::check::CheckFailure;
 use tetcdt::error::{EXIT_MESH_FAILED, EXIT_OK, EXIT_USAGE};
 use tetcdt::options::Options;
 
@@ -207,10 +208,11 @@ fn run(args: Vec<OsString>) -> Result<i32, Failure> {
     cli::run(inv, generated_by(&args), start)
 }
 
-/// The failure of `--check`: every problem, one per line.
-fn check_failure(problems: &[String]) -> Failure {
-    let mut msg = format!("mesh check failed with {} problem(s):", problems.len());
-    for p in problems {
+/// The failure of `--check`: how many problems there are, then the listed ones, one per
+/// line.
+fn check_failure(problems: &CheckFailure) -> Failure {
+    let mut msg = format!("mesh check failed with {} problem(s):", problems.total);
+    for p in problems.to_string().lines() {
         msg.push_str("\n  ");
         msg.push_str(p);
     }
@@ -334,11 +336,28 @@ mod tests {
 
     #[test]
     fn check_failures_list_every_problem() {
-        let f = check_failure(&["tet 3 is inverted".into(), "face 7 is not Delaunay".into()]);
+        let f = check_failure(&CheckFailure {
+            listed: vec!["tet 3 is inverted".into(), "face 7 is not Delaunay".into()],
+            total: 2,
+        });
         assert_eq!(f.code, EXIT_MESH_FAILED);
         assert_eq!(
             error_chain(&f.err),
             "mesh check failed with 2 problem(s):\n  tet 3 is inverted\n  face 7 is not Delaunay"
+        );
+    }
+
+    /// The count is of every problem, not of the lines listed (twenty, and one for the
+    /// rest): 33 shims were once announced as "21 problem(s)".
+    #[test]
+    fn check_failures_count_the_problems_not_listed() {
+        let f = check_failure(&CheckFailure {
+            listed: vec!["tet 3 is a shim".into()],
+            total: 14,
+        });
+        assert_eq!(
+            error_chain(&f.err),
+            "mesh check failed with 14 problem(s):\n  tet 3 is a shim\n  ... and 13 more problems"
         );
     }
 }

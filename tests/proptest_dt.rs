@@ -11,7 +11,7 @@ fn mesh_and_check(points: Vec<[f64; 3]>) -> Result<(), TestCaseError> {
     match tetrahedralize(&plc, &Options::default()) {
         Ok(m) => {
             if let Err(problems) = check_mesh(&plc, &m.mesh) {
-                return Err(TestCaseError::fail(problems.join("\n")));
+                return Err(TestCaseError::fail(problems.to_string()));
             }
             Ok(())
         }

@@ -34,16 +34,39 @@ impl Problems {
             self.more += 1;
         }
     }
-    fn finish(mut self) -> Result<(), Vec<String>> {
-        if self.more > 0 {
-            self.list
-                .push(format!("... and {} more problems", self.more));
-        }
+    fn finish(self) -> Result<(), CheckFailure> {
         if self.list.is_empty() {
             Ok(())
         } else {
-            Err(self.list)
+            Err(CheckFailure {
+                total: self.list.len() + self.more,
+                listed: self.list,
+            })
         }
+    }
+}
+
+/// What a failed check found: the first problems, a line each, and how many there are.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CheckFailure {
+    /// The first problems found, at most twenty.
+    pub listed: Vec<String>,
+    /// How many problems there are in all, listed or not.
+    pub total: usize,
+}
+
+impl std::fmt::Display for CheckFailure {
+    /// The listed problems, one per line, and a last line counting the others.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.listed.join("\n"))?;
+        if self.total > self.listed.len() {
+            write!(
+                f,
+                "\n... and {} more problems",
+                self.total - self.listed.len()
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -56,7 +79,7 @@ struct FaceEntry {
 }
 
 /// Checks `mesh` against `plc`; returns the problems found (empty means valid).
-pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), Vec<String>> {
+pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), CheckFailure> {
     let mut pr = Problems {
         list: Vec::new(),
         more: 0,
@@ -684,10 +707,10 @@ mod tests {
         let mut m = meshed(&plc);
         assert!(!m.hull_faces.is_empty());
         m.hull_faces[0].swap(1, 2);
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(e.contains("hull face 0"), "{e}");
         m.hull_faces.pop();
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(e.contains("hull faces but has"), "{e}");
     }
 
@@ -696,7 +719,7 @@ mod tests {
         let plc = cube_with_center();
         let mut m = meshed(&plc);
         m.tets[0].swap(0, 1);
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(e.contains("not positively oriented"), "{e}");
     }
 
@@ -707,7 +730,7 @@ mod tests {
         let all_used_before = m.tets.len();
         m.tets.remove(all_used_before / 2);
         m.neighbors.clear();
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(e.contains("boundary"), "{e}");
     }
 
@@ -736,7 +759,7 @@ mod tests {
             tets: vec![orient([0, 1, 2, 3]), orient([0, 1, 2, 4])],
             ..Default::default()
         };
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(
             e.contains("not locally Delaunay") || e.contains("not convex"),
             "{e}"
@@ -791,7 +814,7 @@ mod tests {
         // The cube meshed without its inner point, checked against the model with it.
         let mut lost = crate::tetrahedralize(&cube(false), &opts).unwrap().mesh;
         lost.points.push(full.points[8]);
-        let e = check_mesh(&full, &lost).unwrap_err().join("\n");
+        let e = check_mesh(&full, &lost).unwrap_err().to_string();
         assert!(e.contains("input point 8 lies in tet"), "{e}");
     }
 
@@ -844,11 +867,22 @@ mod tests {
         m.subfaces.retain(|(f, _)| f.contains(&4));
         m.subfaces.extend([([0, 1, 3], 0), ([1, 2, 3], 0)]);
         let e = check_mesh(&plc, &m).unwrap_err();
-        assert_eq!(e.len(), 1, "{e:?}");
+        assert_eq!(e.total, 1, "{e:?}");
         assert!(
-            e[0].starts_with("tet 0 ") && e[0].contains("is a shim"),
+            e.listed[0].starts_with("tet 0 ") && e.listed[0].contains("is a shim"),
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn problems_past_the_listed_ones_are_counted() {
+        let plc = cube_with_center();
+        let mut m = meshed(&plc);
+        m.tets = vec![[0, 0, 1, 2]; 30];
+        m.neighbors.clear();
+        let e = check_mesh(&plc, &m).unwrap_err();
+        assert_eq!((e.total, e.listed.len()), (30, 20), "{e:?}");
+        assert!(e.to_string().ends_with("\n... and 10 more problems"), "{e}");
     }
 
     #[test]
@@ -858,7 +892,7 @@ mod tests {
         let t = m.tets[0];
         m.tets.push(t);
         m.neighbors.clear();
-        let e = check_mesh(&plc, &m).unwrap_err().join("\n");
+        let e = check_mesh(&plc, &m).unwrap_err().to_string();
         assert!(e.contains("shared by"), "{e}");
     }
 }
