@@ -51,6 +51,10 @@ impl Stats {
                 p.flat_tets_left.to_string(),
             ),
             (
+                "    thick tets left in a facet's slab",
+                p.thick_tets_left.to_string(),
+            ),
+            (
                 "    free-point searches cut short",
                 p.free_searches_cut.to_string(),
             ),
@@ -168,12 +172,13 @@ impl Stats {
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 22] = [
+            let pairs: [(&str, String); 23] = [
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),
                 ("free_steiner_points", p.free_steiner_points.to_string()),
                 ("flat_tets_left", p.flat_tets_left.to_string()),
+                ("thick_tets_left", p.thick_tets_left.to_string()),
                 ("free_searches_cut", p.free_searches_cut.to_string()),
                 ("output_subfaces", p.output_subfaces.to_string()),
                 ("recovered_subfaces", p.recovered_subfaces.to_string()),

@@ -597,6 +597,7 @@ fn flat_tets_left_on_a_facet_are_counted_and_reported() {
     assert_eq!(code, 0, "{err}");
     let stats = std::fs::read_to_string(&json).unwrap();
     assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{stats}");
+    assert_eq!(json_number(&stats, "thick_tets_left"), 0, "{stats}");
     assert_eq!(json_number(&stats, "free_searches_cut"), 0, "{stats}");
     assert!(!err.contains("flat tet"), "{err}");
     let all = json_number(&stats, "steiner_points");
@@ -793,6 +794,7 @@ fn a_refused_free_point_goes_in_with_the_facets_its_cavity_wraps_around_recovere
             "{sw} {stats}"
         );
         assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{sw} {stats}");
+        assert_eq!(json_number(&stats, "thick_tets_left"), 0, "{sw} {stats}");
     }
 }
 
@@ -808,6 +810,7 @@ fn a_free_point_that_would_remove_a_subsegment_gives_way_to_its_split_in_place()
             "{sw} {stats}"
         );
         assert_eq!(json_number(&stats, "flat_tets_left"), 0, "{sw} {stats}");
+        assert_eq!(json_number(&stats, "thick_tets_left"), 0, "{sw} {stats}");
     }
 }
 

@@ -51,9 +51,8 @@ pub(super) struct Built {
     pub seg_markers: FxHashMap<(VertexId, VertexId), i32>,
     /// The CDT's carving, if one was made since it last changed.
     pub carved: Option<Carved>,
-    /// How many flat tets lie on one facet (of the all-merged facets), and the facet of
-    /// the first.
-    pub flat_left: (usize, Option<u32>),
+    /// The tets left with all four vertices on one facet (of the all-merged facets).
+    pub flat_left: slivers::OnFacets,
     /// When a few tets are left on facets: points for another construction that may
     /// leave none (see [`slivers::flat_left`]).
     pub retry_points: Vec<Point>,
@@ -182,7 +181,7 @@ struct Construction<'a> {
     /// The carving of the CDT as it stands, while nothing changes it.
     carved: Option<Carved>,
     /// The flat tets left on facets, when known (`None` after points went in).
-    flat_left: Option<(usize, Option<u32>)>,
+    flat_left: Option<slivers::OnFacets>,
     /// The work of the construction before its free points (their search is bounded
     /// apart).
     facet_work: u64,
@@ -824,7 +823,7 @@ impl<'a> Construction<'a> {
         }
         let (flat_left, retry_points) = match self.flat_left {
             // Known, and too many (or none) for other constructions: no search needed.
-            Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.0) => (known, Vec::new()),
+            Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.tets) => (known, Vec::new()),
             _ => {
                 let search = self.search.get_or_insert_with(|| {
                     flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)

@@ -139,6 +139,9 @@ pub struct PlcStats {
     pub free_steiner_points: usize,
     /// Flat tets left with all four vertices on one facet (no free point removed them).
     pub flat_tets_left: usize,
+    /// Thick tets left with all four vertices on one facet: squashed within the slab
+    /// of a facet that bends, where their faces may cover it beside its triangles.
+    pub thick_tets_left: usize,
     /// Constructions whose search for free points stopped at its bound on work (around
     /// vertices far out of the model's scale), leaving flat tets it did not get to.
     pub free_searches_cut: usize,
@@ -382,7 +385,7 @@ pub fn mesh_plc_with_progress(
             Attempt::Done(built) => match retry.as_mut() {
                 None if !built.retry_points.is_empty() => {
                     if debug() {
-                        eprintln!("{} tets left on facets: retries", built.flat_left.0);
+                        eprintln!("{} tets left on facets: retries", built.flat_left.tets);
                     }
                     let points = built.retry_points.clone();
                     let r = retry.insert(Retry {
@@ -398,10 +401,10 @@ pub fn mesh_plc_with_progress(
                     if debug() {
                         eprintln!(
                             "retry with {:?}: {} left, covering {}",
-                            r.points[r.next], built.flat_left.0, built.first_point_covers
+                            r.points[r.next], built.flat_left.tets, built.first_point_covers
                         );
                     }
-                    if built.flat_left.0 == 0 && !built.first_point_covers {
+                    if built.flat_left.tets == 0 && !built.first_point_covers {
                         break built;
                     }
                     retry_failed = true;
@@ -453,11 +456,12 @@ pub fn mesh_plc_with_progress(
     let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
     stats.facet_steiner_points += facet_points.len() - free;
     stats.free_steiner_points += free;
-    let (flat, first) = built.flat_left;
-    stats.flat_tets_left = flat;
-    if let Some(f) = first.filter(|_| flat > 0) {
+    let left = built.flat_left;
+    stats.flat_tets_left = left.flat;
+    stats.thick_tets_left = left.tets - left.flat;
+    if let Some(f) = left.first.filter(|_| left.tets > 0) {
         let facet = facet_name(plc, &merged.facets[f as usize]);
-        warnings.push(flat_tets_warning(flat, &facet, stats.free_searches_cut > 0));
+        warnings.push(flat_tets_warning(left, &facet, stats.free_searches_cut > 0));
     }
     let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
     Ok(PlcMesh {
@@ -522,19 +526,30 @@ fn prepare_beside_delaunay(
     Ok((prepared, first_dt?))
 }
 
-/// The warning for `flat` flat tets left on facets, the first on `facet` (`cut`: the
-/// search for free points stopped at its bound on work).
-fn flat_tets_warning(flat: usize, facet: &str, cut: bool) -> String {
+/// The warning for the tets `left` on facets, the first on `facet` (`cut`: the search
+/// for free points stopped at its bound on work).
+fn flat_tets_warning(left: slivers::OnFacets, facet: &str, cut: bool) -> String {
     let why = if cut {
         "which the search for free Steiner points, cut short at its bound on work (a \
          vertex far out of the model's scale makes it long), did not remove"
     } else {
         "which no free Steiner point could remove"
     };
+    let thick = left.tets - left.flat;
+    let what = match (left.flat, thick) {
+        (flat, 0) => format!("{flat} flat tet(s) with all four vertices on one facet remain"),
+        (0, _) => format!(
+            "{thick} thick tet(s) with all four vertices on one facet, squashed within the \
+             slab where it bends, remain"
+        ),
+        (flat, _) => format!(
+            "{flat} flat tet(s) with all four vertices on one facet remain, and {thick} \
+             thick one(s) squashed within the slab of a facet that bends"
+        ),
+    };
     format!(
-        "{flat} flat tet(s) with all four vertices on one facet remain, the first on facet \
-         {facet}: steps or dents of facets that are not flat, {why} (checks for shim tets, \
-         `--check` among them, flag them)"
+        "{what}, the first on facet {facet}: steps or dents of facets that are not flat, \
+         {why} (checks for shim tets, `--check` among them, flag the flat ones)"
     )
 }
 
@@ -1024,6 +1039,39 @@ fn finish(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Thick tets in a bent facet's slab are not called flat: a warning once said "302
+    /// flat tet(s)" of a mesh with 52 flat ones.
+    #[test]
+    fn the_warning_tells_flat_tets_from_thick_ones() {
+        let left = |tets, flat| slivers::OnFacets {
+            tets,
+            flat,
+            first: Some(0),
+        };
+        let w = flat_tets_warning(left(3, 3), "7", false);
+        assert!(
+            w.starts_with(
+                "3 flat tet(s) with all four vertices on one facet remain, the first on facet 7:"
+            ),
+            "{w}"
+        );
+        assert!(!w.contains("thick"), "{w}");
+        let w = flat_tets_warning(left(302, 52), "90", false);
+        assert!(
+            w.starts_with(
+                "52 flat tet(s) with all four vertices on one facet remain, and 250 thick one(s)"
+            ),
+            "{w}"
+        );
+        let w = flat_tets_warning(left(4, 0), "1", true);
+        assert!(
+            w.starts_with("4 thick tet(s) with all four vertices on one facet"),
+            "{w}"
+        );
+        assert!(!w.contains("flat tet"), "{w}");
+        assert!(w.contains("cut short"), "{w}");
+    }
 
     #[test]
     fn a_cancelled_run_stops_with_its_own_error() {

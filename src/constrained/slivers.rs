@@ -269,6 +269,28 @@ pub(crate) struct Candidate {
     pub checked: bool,
 }
 
+/// The tets that carving keeps with all four vertices on one facet.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct OnFacets {
+    /// How many there are.
+    pub tets: usize,
+    /// How many of them are flat; the others are thick but squashed within the slab of
+    /// a facet that bends.
+    pub flat: usize,
+    /// The facet of the first.
+    pub first: Option<u32>,
+}
+
+impl OnFacets {
+    fn of(tets: &[(crate::mesh::TetId, u32, bool)]) -> Self {
+        OnFacets {
+            tets: tets.len(),
+            flat: tets.iter().filter(|x| x.2).count(),
+            first: tets.first().map(|x| x.1),
+        }
+    }
+}
+
 /// What [`free_points`] found.
 #[derive(Default)]
 pub(crate) struct FlatTets {
@@ -279,8 +301,8 @@ pub(crate) struct FlatTets {
     /// The kept flat tets for which no free vertex was found (their circumspheres lie
     /// within the facet's slab), by their vertices.
     pub stuck: Vec<[crate::mesh::VertexId; 4]>,
-    /// How many tets on facets there are, and the facet of the first.
-    pub found: (usize, Option<u32>),
+    /// The tets on facets, as found before any of the points goes in.
+    pub found: OnFacets,
 }
 
 /// The tets on facets that carving keeps: each with its facet and whether it is flat.
@@ -358,12 +380,12 @@ pub(crate) fn flat_left(
     search: &Search<'_>,
     carved: &mut Option<Carved>,
     max_retry: usize,
-) -> ((usize, Option<u32>), Vec<Point>) {
+) -> (OnFacets, Vec<Point>) {
     let Some(found) = find_flat(cdt, search, carved) else {
-        return ((0, None), Vec::new());
+        return (OnFacets::default(), Vec::new());
     };
-    let left = (found.tets.len(), found.tets.first().map(|x| x.1));
-    let retry = if left.0 <= max_retry {
+    let left = OnFacets::of(&found.tets);
+    let retry = if left.tets <= max_retry {
         retry_points(cdt, search, &found)
     } else {
         Vec::new()
@@ -388,7 +410,7 @@ pub(crate) fn free_points(
     // A free point is sought off every facet's slab first: all are needed from here on.
     let slabs = &search.index().slabs;
     let mut out = FlatTets {
-        found: (tets.len(), tets.first().map(|x| x.1)),
+        found: OnFacets::of(&tets),
         ..Default::default()
     };
     for (t, f, flat) in tets {
