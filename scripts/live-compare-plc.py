@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Live comparison with TetGen on fresh random PLCs.
 
-usage: scripts/live-compare-plc.py [--cases N] [--seed S] [--keep DIR] [--big]
+usage: scripts/live-compare-plc.py [--cases N] [--seed S] [--keep DIR] [--big | --medium]
 
 Each case is a closed star-shaped surface: a latitude-longitude grid of 2 to 8 rings of
 3 to 14 points around the z axis, each point moved along its ray by up to 5%, 20% or
@@ -11,6 +11,9 @@ points inside its kernel; in half of the cases every coordinate is rounded to a 
 changes on every run (from the clock) and is printed; `--seed S` repeats a run.
 --big draws finer surfaces instead (20 to 60 rings of 30 to 120 points, 0, 2,000 or
 20,000 points inside, no grid) and prints each program's wall time.
+--medium draws the sharpest of those at a middle size (20 to 36 rings of 40 to 90
+points, every point moved by up to 40%, 0 or 2,000 points inside, no grid), and prints
+the times too.
 
 For each case it runs `tetgen -pO0Q` (Debian TetGen 1.5), then `tetcdt -pQ` and
 `tetcdt -pQF`, and asks:
@@ -38,13 +41,16 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def star(rng, big=False):
+def star(rng, size="small"):
     """(points, triangles) of a random star-shaped closed surface with points inside."""
-    if big:
+    big = size != "small"
+    if size == "big":
         nlat, nlon = rng.randint(20, 60), rng.randint(30, 120)
+    elif size == "medium":
+        nlat, nlon = rng.randint(20, 36), rng.randint(40, 90)
     else:
         nlat, nlon = rng.randint(2, 8), rng.randint(3, 14)
-    amp = rng.choice([0.05, 0.2, 0.4])
+    amp = 0.4 if size == "medium" else rng.choice([0.05, 0.2, 0.4])
     scale = 0 if big else rng.choice([0, 30])
     pts, seen = [], set()
 
@@ -96,7 +102,8 @@ def star(rng, big=False):
                 tris += [(a, c, d), (a, d, b)]
             else:
                 tris += [(a, c, b), (b, c, d)]
-    for _ in range(rng.choice([0, 2000, 20000] if big else [0, 20, 100, 400])):
+    inner = {"big": [0, 2000, 20000], "medium": [0, 2000], "small": [0, 20, 100, 400]}[size]
+    for _ in range(rng.choice(inner)):
         while True:
             q = [rng.uniform(-1, 1) for _ in range(3)]
             if sum(x * x for x in q) < 1:
@@ -157,8 +164,11 @@ def main():
         print(__doc__)
         return 0
     opts = {"--cases": "12", "--seed": None, "--keep": None}
-    big = "--big" in args
-    args = [a for a in args if a != "--big"]
+    size = "big" if "--big" in args else "medium" if "--medium" in args else "small"
+    if "--big" in args and "--medium" in args:
+        sys.exit("live-compare-plc.py: --big and --medium exclude each other")
+    big = size != "small"
+    args = [a for a in args if a not in ("--big", "--medium")]
     while args:
         k = args.pop(0)
         if k not in opts or not args:
@@ -178,14 +188,14 @@ def main():
     if shutil.which("tetgen") is None:
         sys.exit("live-compare-plc.py: FAIL: tetgen is not on PATH (apt-get install tetgen)")
     print(f"live-compare-plc: seed {seed} (repeat: scripts/live-compare-plc.py --seed {seed} "
-          f"--cases {opts['--cases']}{' --big' if big else ''})")
+          f"--cases {opts['--cases']}{'' if size == 'small' else ' --' + size})")
     work = opts["--keep"] or tempfile.mkdtemp(prefix="tetcdt-live-plc.")
     os.makedirs(work, exist_ok=True)
     rng = random.Random(seed)
     failed, identical, tg_failed, refused = [], 0, 0, 0
     for case in range(int(opts["--cases"])):
         name = f"star{case}"
-        pts, tris = star(rng, big)
+        pts, tris = star(rng, size)
         inp = os.path.join(work, name + ".poly")
         write_poly(inp, pts, tris)
         distinct = {tuple(float(c) for c in p) for p in pts}
