@@ -156,9 +156,11 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), CheckFailure> {
     check_hull_faces(mesh, &mut boundary, &mut pr);
     check_boundary(mesh, &boundary, &mut pr);
     if mesh.plc_mode {
-        check_constraints(plc, mesh, &subfaces, &boundary, &mut pr);
-        check_points_kept(plc, mesh, &mut pr);
-        check_shims(plc, mesh, &mut pr);
+        // Each input point's first copy, which stands for its duplicates in the mesh.
+        let rep = crate::precheck::representatives(&plc.points);
+        check_constraints(plc, mesh, &rep, &subfaces, &boundary, &mut pr);
+        check_points_kept(plc, mesh, &rep, &mut pr);
+        check_shims(plc, mesh, &rep, &mut pr);
     } else {
         check_vertices_used(plc, mesh, &mut pr);
     }
@@ -201,6 +203,7 @@ fn check_hull_faces(mesh: &MeshOut, boundary: &mut [(u32, u8)], pr: &mut Problem
 fn check_constraints(
     plc: &Plc,
     mesh: &MeshOut,
+    rep: &[u32],
     subfaces: &rustc_hash::FxHashSet<[u32; 3]>,
     boundary: &[(u32, u8)],
     pr: &mut Problems,
@@ -251,7 +254,6 @@ fn check_constraints(
         adj.entry(a).or_default().push(b);
         adj.entry(b).or_default().push(a);
     }
-    let rep = crate::precheck::representatives(&plc.points);
     let mut seen_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
     for (fi, facet) in plc.facets.iter().enumerate() {
         for poly in &facet.polygons {
@@ -271,7 +273,7 @@ fn check_constraints(
                     // need no subsegments, but their facets still cover them. (A polygon
                     // that carving would drop is refused by the mesher, so every
                     // constraint edge must be here.)
-                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, &rep, a, b) {
+                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, rep, a, b) {
                         pr.push(format!(
                             "facet {}: edge ({}, {}) is not covered by subsegments",
                             fi + base,
@@ -286,9 +288,8 @@ fn check_constraints(
 }
 
 /// No shim tet may survive: a flat tet whose four vertices lie on one (merged) facet.
-fn check_shims(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
-    let rep = crate::precheck::representatives(&plc.points);
-    let found = shims::shims(plc, mesh, &rep);
+fn check_shims(plc: &Plc, mesh: &MeshOut, rep: &[u32], pr: &mut Problems) {
+    let found = shims::shims(plc, mesh, rep);
     let base = mesh.first_index;
     for &(t, facet) in &found {
         pr.push(format!(
@@ -313,14 +314,13 @@ fn in_tet(mesh: &MeshOut, t: &[u32; 4], q: &Point) -> bool {
 
 /// PLC meshes: an input point that is no mesh vertex must lie outside the mesh (carved
 /// away with the exterior or a hole), and never inside a tet.
-fn check_points_kept(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
+fn check_points_kept(plc: &Plc, mesh: &MeshOut, rep: &[u32], pr: &mut Problems) {
     let mut used = vec![false; mesh.points.len()];
     for t in &mesh.tets {
         for &v in t {
             used[v as usize] = true;
         }
     }
-    let rep = crate::precheck::representatives(&plc.points);
     let unused: Vec<u32> = (0..plc.points.len() as u32)
         .filter(|&i| rep[i as usize] == i && !used.get(i as usize).copied().unwrap_or(false))
         .collect();

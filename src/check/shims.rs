@@ -7,7 +7,7 @@
 //! two check each other.
 
 use crate::constrained::prepare::{dedup_ring, newell_normal, Dsu};
-use crate::geom::{bounding_box, dot, orient3d, Point};
+use crate::geom::{diagonal, dot, longest_edge2, norm, orient3d, Point};
 use crate::output::MeshOut;
 use crate::plc::Plc;
 use crate::precheck::bvh::{Aabb, Bvh};
@@ -196,29 +196,9 @@ fn merge_coplanar(pts: &[Point], polys: &[(usize, Vec<u32>)]) -> Vec<Vec<usize>>
     out
 }
 
-fn norm(v: &Point) -> f64 {
-    dot(v, v).sqrt()
-}
-
-/// The diagonal of the points' bounding box (1 for an empty or degenerate set).
-fn diagonal(pts: &[Point]) -> f64 {
-    let [lo, hi] = bounding_box(pts);
-    let d = norm(&std::array::from_fn(|k| hi[k] - lo[k]));
-    if d > 0.0 && d.is_finite() {
-        d
-    } else {
-        1.0
-    }
-}
-
 /// Whether the tet's volume is at most [`FLAT`] times its longest edge cubed.
 fn is_flat(p: &[Point; 4]) -> bool {
-    let mut l2 = 0.0f64;
-    for i in 0..4 {
-        for j in i + 1..4 {
-            l2 = l2.max((0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum());
-        }
-    }
+    let l2 = longest_edge2(p);
     orient3d(&p[0], &p[1], &p[2], &p[3]).abs() / 6.0 <= FLAT * l2 * l2.sqrt()
 }
 

@@ -14,6 +14,7 @@
 //!   both rings (3 or more vertices) of the same group.
 
 use crate::error::InputError;
+use crate::geom::norm;
 use crate::plc::Plc;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -90,10 +91,6 @@ pub fn newell_normal(points: &[[f64; 3]], ring: &[u32]) -> [f64; 3] {
         n[2] += (a[0] - b[0]) * (a[1] + b[1]);
     }
     n
-}
-
-fn norm(n: [f64; 3]) -> f64 {
-    (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
 }
 
 /// Exact test: are all vertices of the ring on one line? (All three axis projections
@@ -251,7 +248,7 @@ pub fn prepare_except(
                 return None;
             }
             let nn = newell_normal(pts, &p.verts);
-            let l = norm(nn);
+            let l = norm(&nn);
             (l > 0.0).then(|| nn.map(|x| x / l))
         })
         .collect();
@@ -327,7 +324,7 @@ pub fn prepare_except(
                 }
                 _ => {
                     let nn = newell_normal(pts, &p.verts);
-                    let l = norm(nn);
+                    let l = norm(&nn);
                     if l > best {
                         best = l;
                         mf.normal = nn.map(|x| x / l);
@@ -421,7 +418,7 @@ mod tests {
                 assert_eq!(f.source_facets, vec![i]);
                 assert_eq!(f.marker, i as i32 + 1);
                 assert_eq!(f.rings.len(), 1);
-                let l = norm(f.normal);
+                let l = norm(&f.normal);
                 assert!((l - 1.0).abs() < 1e-12);
             }
             // Bottom face 0,2,3,1 is clockwise seen from +z: normal points down.

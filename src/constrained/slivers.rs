@@ -10,7 +10,7 @@ use super::cdt::Cdt;
 use super::prepare::{newell_normal, PreparedPlc};
 use crate::carve::{carve, containing_tet_near, Carved};
 use crate::geom::predicates::{insphere, orient3d};
-use crate::geom::{cross, dot, sub, Point};
+use crate::geom::{cross, diagonal, dot, longest_edge2, sub, Point};
 use crate::mesh::VertexId;
 use crate::plc::Region;
 use rustc_hash::FxHashMap;
@@ -691,25 +691,6 @@ fn circumsphere(p: &[Point; 4]) -> Option<(Point, f64)> {
     let off: Point = std::array::from_fn(|k| (n[0] * c12[k] + n[1] * c20[k] + n[2] * c01[k]) / det);
     let r = dot(&off, &off).sqrt();
     (r.is_finite() && det != 0.0).then(|| (std::array::from_fn(|k| p[0][k] + off[k]), r))
-}
-
-/// The length of the bounding box's diagonal (1 for a single point).
-fn diagonal(points: &[Point]) -> f64 {
-    let [lo, hi] = crate::geom::bounding_box(points);
-    let d = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
-    if d > 0.0 {
-        d
-    } else {
-        1.0
-    }
-}
-
-/// The square of the tet's longest edge.
-fn longest_edge2(p: &[Point; 4]) -> f64 {
-    crate::mesh::EDGE_VERTS
-        .iter()
-        .map(|&(i, j)| (0..3).map(|k| (p[i][k] - p[j][k]).powi(2)).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]

@@ -63,6 +63,35 @@ pub fn bounding_box(points: &[Point]) -> [Point; 2] {
     [lo, hi]
 }
 
+/// The length of `v`.
+pub fn norm(v: &Point) -> f64 {
+    dot(v, v).sqrt()
+}
+
+/// The length of the diagonal of the points' bounding box, or 1 where it is zero (a
+/// single point, or none): a scale for tolerances relative to the model.
+pub fn diagonal(points: &[Point]) -> f64 {
+    let [lo, hi] = bounding_box(points);
+    let d = norm(&sub(&hi, &lo));
+    if d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}
+
+/// The square of the tet's longest edge.
+pub fn longest_edge2(p: &[Point; 4]) -> f64 {
+    let mut l2 = 0.0f64;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let e = sub(&p[i], &p[j]);
+            l2 = l2.max(dot(&e, &e));
+        }
+    }
+    l2
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
