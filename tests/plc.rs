@@ -690,15 +690,21 @@ fn checked_stats(model: &Path, dir: &Path, tag: &str, switch: &str) -> String {
 
 #[test]
 fn a_steiner_point_on_a_polygon_goes_into_the_cdt_without_a_restart() {
-    // One polygon of hand.off is not flat enough: its two sides disagree, and a Steiner
-    // point on it settles them. The point is put into the CDT by a walled cavity and
-    // flips, and the polygon is triangulated again with it; the construction used to
+    // One polygon of fine_star_point is not flat enough: its two sides disagree, and a
+    // Steiner point on it settles them. The point is put into the CDT by a walled cavity
+    // and flips, and the polygon is triangulated again with it; the construction used to
     // start again from the Delaunay stage.
-    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/hand.off");
+    let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/fine_star_point.poly");
     let dir = tempfile::tempdir().unwrap();
-    let stats = checked_stats(&m, dir.path(), "c", "-pQ");
-    assert_eq!(json_number(&stats, "facet_steiner_points"), 1, "{stats}");
-    assert_eq!(json_number(&stats, "restarts"), 0, "{stats}");
+    for (tag, flag) in [("c", "-pQ"), ("f", "-pQF")] {
+        let stats = checked_stats(&m, dir.path(), tag, flag);
+        assert_eq!(
+            json_number(&stats, "facet_steiner_points"),
+            1,
+            "{tag}: {stats}"
+        );
+        assert_eq!(json_number(&stats, "restarts"), 0, "{tag}: {stats}");
+    }
 }
 
 #[test]
@@ -734,16 +740,15 @@ fn a_split_point_whose_flips_a_subface_blocks_goes_in_with_that_facet_unrecovere
     // edge of a subface of a facet that does not hold the subsegment: that facet is
     // unrecovered too, and recovered again after the split. The construction used to
     // restart there.
-    updated_in_place_without_restart("rotor_small.off", 2);
+    updated_in_place_without_restart("rotor_small.off", [2, 2]);
 }
 
 #[test]
 fn subsegments_that_encroach_upon_each_other_in_a_group_split_in_place_together() {
-    // In fine_star_group, splitting the two subsegments at a sharp corner on one shell
-    // puts points that would remove three more subsegments (of other segments, at that
-    // corner and elsewhere): all five are split in place at once, each on the shell or at
-    // its middle, where the construction used to restart.
-    updated_in_place_without_restart("fine_star_group.poly", 1);
+    // In fine_star_group, five subsegments near a pole need splits in place whose points
+    // would each remove another of them: all five are split in place at once, where the
+    // construction used to restart.
+    updated_in_place_without_restart("fine_star_group.poly", [1, 1]);
 }
 
 #[test]
@@ -767,7 +772,7 @@ fn subsegments_at_a_sharp_corner_that_encroach_upon_each_other_split_in_place_to
     // whose middle would remove a subsegment of a neighbouring segment, and that one's
     // middle the first: both are split at one distance from the segments' shared end,
     // in place, where the construction used to restart.
-    for (sw, stats) in updated_in_place_without_restart("fine_star.poly", 1) {
+    for (sw, stats) in updated_in_place_without_restart("fine_star.poly", [1, 1]) {
         assert_eq!(
             json_number(&stats, "facet_steiner_points"),
             0,
@@ -787,7 +792,7 @@ fn a_refused_free_point_goes_in_with_the_facets_its_cavity_wraps_around_recovere
     // and the facet is recovered again around it (one update, besides the one for a
     // Steiner point on a polygon), where the referee finds no face of the new tets lying
     // on a facet beside its triangles.
-    for (sw, stats) in updated_in_place_without_restart("anchor.off", 2) {
+    for (sw, stats) in updated_in_place_without_restart("anchor.off", [2, 2]) {
         assert_eq!(
             json_number(&stats, "free_steiner_points"),
             1,
@@ -804,7 +809,7 @@ fn a_free_point_that_would_remove_a_subsegment_gives_way_to_its_split_in_place()
     // the facets their cavities wrap around are taken out): the subsegments are split in
     // place instead, the facets through them recovered again, and the next round's free
     // points go in, where the construction used to restart with the refused points.
-    for (sw, stats) in updated_in_place_without_restart("mpi.off", 3) {
+    for (sw, stats) in updated_in_place_without_restart("mpi.off", [3, 3]) {
         assert!(
             json_number(&stats, "free_steiner_points") >= 1,
             "{sw} {stats}"
@@ -816,20 +821,24 @@ fn a_free_point_that_would_remove_a_subsegment_gives_way_to_its_split_in_place()
 
 #[test]
 fn a_group_of_more_than_eight_subsegments_at_a_sharp_corner_splits_in_place() {
-    // In fine_star_wide_group, the group split at a pole's fan grows past eight
-    // subsegments (the points on one shell would remove more of the fan's spokes): all
-    // are split in place at once, where groups of at most eight made the construction
-    // restart.
-    updated_in_place_without_restart("fine_star_wide_group.poly", 1);
+    // In fine_star_wide_group, one group of subsegments split in place grows to eleven
+    // (each split point would remove another subsegment nearby): all are split in place
+    // at once, where groups of at most eight made the construction restart.
+    updated_in_place_without_restart("fine_star_wide_group.poly", [4, 5]);
 }
 
-fn updated_in_place_without_restart(model: &str, in_place: usize) -> Vec<(&'static str, String)> {
+/// Meshes `model` with `-pQ` and `-pQF`, requiring no restart and `in_place` updates in
+/// place (for each switch); the statistics of both runs.
+fn updated_in_place_without_restart(
+    model: &str,
+    in_place: [usize; 2],
+) -> Vec<(&'static str, String)> {
     let m = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("data/nonflat")
         .join(model);
     let dir = tempfile::tempdir().unwrap();
     let mut out = Vec::new();
-    for sw in ["-pQ", "-pQF"] {
+    for (sw, in_place) in ["-pQ", "-pQF"].into_iter().zip(in_place) {
         let stats = checked_stats(&m, dir.path(), model, sw);
         assert_eq!(json_number(&stats, "restarts"), 0, "{model} {sw} {stats}");
         assert_eq!(

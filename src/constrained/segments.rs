@@ -4,8 +4,9 @@
 //! Split points avoid needlessly short edges where segments meet at acute angles: next to
 //! an acute vertex a subsegment is split on a sphere centred at that vertex whose radius
 //! is a power of two (concentric shells, as Si & Gärtner and Shewchuk do), so the
-//! subsegments around the vertex shrink together and protect it; elsewhere the midpoint
-//! is used. Steiner points are computed from the segment's original endpoints, so they
+//! subsegments around the vertex shrink together and protect it; elsewhere the vertex
+//! that encroaches most upon the piece decides (its projection, or its distance from an
+//! end the piece's segment shares with the vertex's own), else the midpoint is used. Steiner points are computed from the segment's original endpoints, so they
 //! lie on the segment up to rounding.
 
 use crate::constrained::cdt::edge_key;
@@ -58,6 +59,8 @@ pub fn recover_segments(
         ends.push([ia, ib]);
     }
     let acute = acute_vertices(dt, &ends);
+    // The segment each Steiner point lies on, for the split rule at shared ends.
+    let mut seg_of: Vec<u32> = vec![u32::MAX; dt.points.len()];
     let mut splits: Vec<Vec<(f64, VertexId)>> = vec![Vec::new(); segments.len()];
     let mut steiner = 0usize;
     // Split points asked for by an earlier attempt (to protect a subsegment that a cavity
@@ -70,6 +73,7 @@ pub fn recover_segments(
             *next_pert += 1;
             steiner += 1;
             splits[seg].push((s, w));
+            note_segment(&mut seg_of, w, seg);
         }
     }
     let mut queue: Vec<Piece> = Vec::new();
@@ -130,7 +134,11 @@ pub fn recover_segments(
                 )));
             }
             let [a, b] = ends[pc.seg];
-            let s = split_parameter(dt, pc, [a, b], &acute, &mut scratch);
+            let owners = Owners {
+                seg_of: &seg_of,
+                ends: &ends,
+            };
+            let s = split_parameter(dt, pc, [a, b], &acute, &owners, &mut scratch);
             let pa = dt.points[a as usize];
             let pb = dt.points[b as usize];
             let x: Point = std::array::from_fn(|k| pa[k] + (pb[k] - pa[k]) * s);
@@ -152,6 +160,7 @@ pub fn recover_segments(
             *next_pert += 1;
             steiner += 1;
             splits[pc.seg].push((s, w));
+            note_segment(&mut seg_of, w, pc.seg);
             cavity.of_last_insertion(dt, w);
             for &x in &cavity.verts {
                 if let Some(t) = touched.get_mut(x as usize) {
@@ -441,6 +450,21 @@ fn acute_vertices(dt: &Delaunay, ends: &[[VertexId; 2]]) -> Vec<bool> {
     acute
 }
 
+/// Which segment each Steiner point lies on (`u32::MAX` for other vertices), and the
+/// segments' ends.
+struct Owners<'a> {
+    seg_of: &'a [u32],
+    ends: &'a [[VertexId; 2]],
+}
+
+/// Records that Steiner point `w` lies on segment `seg`.
+fn note_segment(seg_of: &mut Vec<u32>, w: VertexId, seg: usize) {
+    if seg_of.len() <= w as usize {
+        seg_of.resize(w as usize + 1, u32::MAX);
+    }
+    seg_of[w as usize] = seg as u32;
+}
+
 /// Where to split a piece: on a power-of-two sphere around an acute segment endpoint,
 /// else at the middle.
 fn split_parameter(
@@ -448,13 +472,14 @@ fn split_parameter(
     pc: Piece,
     [a, b]: [VertexId; 2],
     acute: &[bool],
+    owners: &Owners,
     scratch: &mut Vec<crate::mesh::TetId>,
 ) -> f64 {
     let mid = 0.5 * (pc.s0 + pc.s1);
     let from_a = pc.u == a && acute[a as usize];
     let from_b = pc.v == b && acute[b as usize];
     if from_a == from_b {
-        return reference_split(dt, pc, [a, b], scratch).unwrap_or(mid);
+        return reference_split(dt, pc, [a, b], owners, scratch).unwrap_or(mid);
     }
     let pa = dt.points[a as usize];
     let pb = dt.points[b as usize];
@@ -474,10 +499,55 @@ fn split_parameter(
     }
 }
 
+/// Split points placed at a shared end's distance are scaled by `1 + SHARED_END_SCALE
+/// * (1 + f)`, `f` in [0, 1) distinct per segment (see [`shared_end_split`]).
+const SHARED_END_SCALE: f64 = 1e-9;
+
+/// Where to split a piece whose reference point `r` is a Steiner point on a segment that
+/// shares an end with this one (TetGen's rule): at `r`'s distance from that end. Split
+/// at `r`'s projection instead, two segments meeting at a small angle chase each other's
+/// split points towards their shared end, each new point encroaching upon the other's
+/// piece a little nearer; at equal distances their points face each other and neither
+/// encroaches. Equal distances on both segments would make the four points of two such
+/// pairs an isosceles trapezoid, cocircular, whose diagonal in the facet rounding decides
+/// (flip insertion then got stuck where the facet's triangulation chose the other one,
+/// and shims formed in such folds): the distance is therefore scaled by a factor that
+/// differs per segment by about 1e-9, far above rounding and far below the squared
+/// angles between segments that the points must keep clear of each other's pieces.
+fn shared_end_split(
+    dt: &Delaunay,
+    pc: Piece,
+    [a, b]: [VertexId; 2],
+    owners: &Owners,
+    r: VertexId,
+) -> Option<f64> {
+    let other = *owners.seg_of.get(r as usize)?;
+    if other == u32::MAX || other as usize == pc.seg {
+        return None;
+    }
+    let ends = owners.ends[other as usize];
+    let p = |v: VertexId| dt.points[v as usize];
+    let dist = |u: VertexId, v: VertexId| {
+        let (x, y) = (p(u), p(v));
+        crate::geom::norm(&[x[0] - y[0], x[1] - y[1], x[2] - y[2]])
+    };
+    let len = dist(a, b);
+    let scale = 1.0 + SHARED_END_SCALE * (1.0 + (pc.seg as f64 * 0.618_033_988_749_895).fract());
+    if ends.contains(&a) {
+        Some(dist(r, a) * scale / len)
+    } else if ends.contains(&b) {
+        Some(1.0 - dist(r, b) * scale / len)
+    } else {
+        None
+    }
+}
+
 /// The split point from the piece's reference point (Si & Gärtner): the neighbour of
 /// its end `u` that sees the piece under the widest angle from inside its diametral
-/// sphere, projected onto the segment. Both halves then leave that vertex on or outside
-/// their diametral spheres, so one split often suffices. A projection close to an end
+/// sphere, projected onto the segment (or, if it lies on a segment sharing an end with
+/// this one, at its distance from that end: [`shared_end_split`]). Both halves then leave
+/// that vertex on or outside their diametral spheres, so one split often suffices. A
+/// projection close to an end
 /// would make a needlessly short edge: there the split goes on the sphere centred at
 /// that end through the reference point instead, which also leaves the reference point
 /// outside the short half's diametral sphere and no shorter than an edge already there.
@@ -485,6 +555,7 @@ fn reference_split(
     dt: &Delaunay,
     pc: Piece,
     [a, b]: [VertexId; 2],
+    owners: &Owners,
     scratch: &mut Vec<crate::mesh::TetId>,
 ) -> Option<f64> {
     let p = |v: VertexId| dt.points[v as usize];
@@ -497,6 +568,7 @@ fn reference_split(
     }
     dt.star(pc.u, scratch);
     let mut best: Option<(f64, f64)> = None; // (cosine of the angle, parameter)
+    let mut best_vertex = crate::mesh::GHOST;
     let mut dist = (0.0, 0.0); // the reference point's distances to u and v
     for &t in scratch.iter() {
         for &x in &dt.mesh.verts(t) {
@@ -517,10 +589,12 @@ fn reference_split(
             if best.is_none_or(|(c, _)| cos < c) {
                 best = Some((cos, s));
                 dist = (ne, nf);
+                best_vertex = x;
             }
         }
     }
     let (_, s) = best?;
+    let s = shared_end_split(dt, pc, [a, b], owners, best_vertex).unwrap_or(s);
     let w = pc.s1 - pc.s0;
     let len = dd.sqrt();
     let s = if s < pc.s0 + 0.1 * w {
@@ -583,6 +657,74 @@ mod tests {
                 "length {d} is not a power of two"
             );
         }
+    }
+
+    #[test]
+    fn segments_at_a_small_angle_are_split_at_one_distance_from_their_shared_end() {
+        // Two segments leave point 0 one degree apart, through a cloud that hides both;
+        // two short segments make their far ends acute too, so that their first pieces
+        // are split from reference points. A point on one segment is the reference of
+        // the other's piece beside it: the split goes at its distance from point 0 (up
+        // to the per-segment scale of about 1e-9), not at its projection (cos 1° nearer),
+        // so that the two segments' split points face each other in pairs.
+        let a = 1f64.to_radians();
+        let mut pts: Vec<Point> = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [a.cos(), a.sin(), 0.0]];
+        pts.push([1.0, -0.01, 0.0]);
+        pts.push([a.cos(), a.sin() + 0.01, 0.0]);
+        let mut s = 5u64;
+        while pts.len() < 400 {
+            let q = [lcg(&mut s), lcg(&mut s) - 0.5, 0.2 * (lcg(&mut s) - 0.5)];
+            if q[2].abs() > 1e-3 {
+                pts.push(q);
+            }
+        }
+        let mut dt = Delaunay::build(&pts).unwrap().dt;
+        let mut next = pts.len() as u32;
+        let segs = [[0, 1], [0, 2], [1, 3], [2, 4]];
+        let rec = recover_segments(
+            &mut dt,
+            &segs,
+            pts.len(),
+            &mut next,
+            100_000,
+            &[],
+            &Default::default(),
+        )
+        .unwrap();
+        assert!(
+            rec.steiner_points < 100,
+            "{} Steiner points",
+            rec.steiner_points
+        );
+        let o = dt.points[rec.chains[0][0] as usize];
+        let radii = |chain: &[VertexId]| -> Vec<f64> {
+            chain[1..chain.len() - 1]
+                .iter()
+                .map(|&v| {
+                    let q = dt.points[v as usize];
+                    crate::geom::norm(&[q[0] - o[0], q[1] - o[1], q[2] - o[2]])
+                })
+                .collect()
+        };
+        let (r0, r1) = (radii(&rec.chains[0]), radii(&rec.chains[1]));
+        // Those off the power-of-two shells around point 0 were placed from references.
+        let off_shells = |r: f64| (r.log2() - r.log2().round()).abs() > 1e-9;
+        let mut paired = 0;
+        for &r in r1.iter().filter(|&&r| off_shells(r)) {
+            let near = r0
+                .iter()
+                .map(|&q| (q - r).abs() / r)
+                .fold(f64::INFINITY, f64::min);
+            if near < 1e-8 {
+                // Near, but not at the same distance: no isosceles trapezoids.
+                assert!(near > 1e-12, "radius {r} repeated exactly");
+                paired += 1;
+            }
+        }
+        assert!(
+            paired >= 5,
+            "{paired} paired split points in {r0:?} and {r1:?}"
+        );
     }
 
     #[test]
