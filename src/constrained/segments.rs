@@ -6,8 +6,9 @@
 //! is a power of two (concentric shells, as Si & Gärtner and Shewchuk do), so the
 //! subsegments around the vertex shrink together and protect it; elsewhere the vertex
 //! that encroaches most upon the piece decides (its projection, or its distance from an
-//! end the piece's segment shares with the vertex's own), else the midpoint is used. Steiner points are computed from the segment's original endpoints, so they
-//! lie on the segment up to rounding.
+//! end the piece's segment shares with the vertex's own), else the midpoint is used.
+//! Steiner points are computed from the segment's original endpoints, so they lie on the
+//! segment up to rounding.
 
 use crate::constrained::cdt::edge_key;
 use crate::delaunay::Delaunay;
@@ -499,8 +500,9 @@ fn split_parameter(
     }
 }
 
-/// Split points placed at a shared end's distance are scaled by `1 + SHARED_END_SCALE
-/// * (1 + f)`, `f` in [0, 1) distinct per segment (see [`shared_end_split`]).
+/// The scale of split points placed at a shared end's distance: the distance is
+/// multiplied by `1 + SHARED_END_SCALE·(1 + f)`, `f` in [0, 1) distinct per segment (see
+/// [`shared_end_split`]).
 const SHARED_END_SCALE: f64 = 1e-9;
 
 /// Where to split a piece whose reference point `r` is a Steiner point on a segment that
@@ -547,10 +549,10 @@ fn shared_end_split(
 /// sphere, projected onto the segment (or, if it lies on a segment sharing an end with
 /// this one, at its distance from that end: [`shared_end_split`]). Both halves then leave
 /// that vertex on or outside their diametral spheres, so one split often suffices. A
-/// projection close to an end
-/// would make a needlessly short edge: there the split goes on the sphere centred at
-/// that end through the reference point instead, which also leaves the reference point
-/// outside the short half's diametral sphere and no shorter than an edge already there.
+/// projection close to an end would make a needlessly short edge: there the split goes on
+/// the sphere centred at that end through the reference point instead, which also leaves
+/// the reference point outside the short half's diametral sphere and no shorter than an
+/// edge already there.
 fn reference_split(
     dt: &Delaunay,
     pc: Piece,
