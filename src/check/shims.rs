@@ -7,7 +7,7 @@
 //! two check each other.
 
 use crate::constrained::prepare::{dedup_ring, newell_normal, Dsu};
-use crate::geom::{diagonal, dot, longest_edge2, norm, orient3d, Point};
+use crate::geom::{diagonal, dot, longest_edge2, norm, orient3d, sub, Point};
 use crate::output::MeshOut;
 use crate::plc::Plc;
 use crate::precheck::bvh::{Aabb, Bvh};
@@ -32,8 +32,8 @@ struct Group {
 
 impl Group {
     fn holds(&self, p: &Point) -> bool {
-        let h: f64 = (0..3).map(|k| (p[k] - self.mean[k]) * self.normal[k]).sum();
-        h.abs() <= self.tol && (0..3).all(|k| p[k] >= self.lo[k] && p[k] <= self.hi[k])
+        dot(&sub(p, &self.mean), &self.normal).abs() <= self.tol
+            && (0..3).all(|k| p[k] >= self.lo[k] && p[k] <= self.hi[k])
     }
 }
 
@@ -84,7 +84,7 @@ pub(super) fn shims(plc: &Plc, mesh: &MeshOut, rep: &[u32]) -> Vec<(usize, usize
         let k = verts.len() as f64;
         let mean: Point =
             std::array::from_fn(|a| verts.iter().map(|&v| pts[v as usize][a]).sum::<f64>() / k);
-        let height = |p: &Point| (0..3).map(|a| (p[a] - mean[a]) * normal[a]).sum::<f64>();
+        let height = |p: &Point| dot(&sub(p, &mean), &normal);
         let dev = verts
             .iter()
             .map(|&v| height(&pts[v as usize]).abs())

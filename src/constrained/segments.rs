@@ -13,7 +13,7 @@
 use crate::constrained::cdt::edge_key;
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
-use crate::geom::Point;
+use crate::geom::{norm, sub, Point};
 use crate::mesh::VertexId;
 
 /// The recovered segments.
@@ -484,7 +484,7 @@ fn split_parameter(
     }
     let pa = dt.points[a as usize];
     let pb = dt.points[b as usize];
-    let len = ((pb[0] - pa[0]).powi(2) + (pb[1] - pa[1]).powi(2) + (pb[2] - pa[2]).powi(2)).sqrt();
+    let len = norm(&sub(&pb, &pa));
     let piece = len * (pc.s1 - pc.s0);
     if !(piece > 0.0 && piece.is_finite()) {
         return mid;
@@ -520,6 +520,7 @@ fn shared_end_split(
     dt: &Delaunay,
     pc: Piece,
     [a, b]: [VertexId; 2],
+    len: f64,
     owners: &Owners,
     r: VertexId,
 ) -> Option<f64> {
@@ -528,17 +529,14 @@ fn shared_end_split(
         return None;
     }
     let ends = owners.ends[other as usize];
-    let p = |v: VertexId| dt.points[v as usize];
-    let dist = |u: VertexId, v: VertexId| {
-        let (x, y) = (p(u), p(v));
-        crate::geom::norm(&[x[0] - y[0], x[1] - y[1], x[2] - y[2]])
-    };
-    let len = dist(a, b);
-    let scale = 1.0 + SHARED_END_SCALE * (1.0 + (pc.seg as f64 * 0.618_033_988_749_895).fract());
+    let dist = |v: VertexId| norm(&sub(&dt.points[r as usize], &dt.points[v as usize]));
+    // The golden ratio's fractional multiples spread the segments' factors over [0, 1).
+    let f = (pc.seg as f64 * 0.618_033_988_749_895).fract();
+    let scale = 1.0 + SHARED_END_SCALE * (1.0 + f);
     if ends.contains(&a) {
-        Some(dist(r, a) * scale / len)
+        Some(dist(a) * scale / len)
     } else if ends.contains(&b) {
-        Some(1.0 - dist(r, b) * scale / len)
+        Some(1.0 - dist(b) * scale / len)
     } else {
         None
     }
@@ -596,9 +594,9 @@ fn reference_split(
         }
     }
     let (_, s) = best?;
-    let s = shared_end_split(dt, pc, [a, b], owners, best_vertex).unwrap_or(s);
     let w = pc.s1 - pc.s0;
     let len = dd.sqrt();
+    let s = shared_end_split(dt, pc, [a, b], len, owners, best_vertex).unwrap_or(s);
     let s = if s < pc.s0 + 0.1 * w {
         pc.s0 + dist.0 / len
     } else if s > pc.s1 - 0.1 * w {
@@ -704,7 +702,7 @@ mod tests {
                 .iter()
                 .map(|&v| {
                     let q = dt.points[v as usize];
-                    crate::geom::norm(&[q[0] - o[0], q[1] - o[1], q[2] - o[2]])
+                    norm(&sub(&q, &o))
                 })
                 .collect()
         };
