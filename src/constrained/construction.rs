@@ -165,11 +165,8 @@ struct Construction<'a> {
     /// split in place), and the facets of each segment, made when first needed.
     retriangulate: Vec<usize>,
     facets_of_seg: Option<Vec<Vec<usize>>>,
-    /// What the flat-tet search needs, made once when first needed (free points leave
-    /// the subsegments as they are, but facets recovered again may split some: then its
-    /// record of them is made again), and the segment splits it knows of.
+    /// What the flat-tet search needs, made once when first needed.
     search: Option<slivers::Search<'a>>,
-    search_splits: usize,
     /// The free points put in with facets recovered again, and the points the first of
     /// them stood in for a restart with.
     free_in_place: Vec<VertexId>,
@@ -323,7 +320,6 @@ impl<'a> Construction<'a> {
             retriangulate: Vec::new(),
             facets_of_seg: None,
             search: None,
-            search_splits: 0,
             free_in_place: Vec::new(),
             restart_instead: None,
             free_splits: false,
@@ -601,17 +597,10 @@ impl<'a> Construction<'a> {
             return Ok(false);
         }
         // Taken out while the rounds run, which change the rest of the state.
-        let mut search = match self.search.take() {
+        let search = match self.search.take() {
             Some(search) => search,
-            None => {
-                self.search_splits = self.subsegs.steiner_points;
-                flat_tet_search(self.plc, self.merged, &self.subsegs, &self.cdt, self.opts)
-            }
+            None => flat_tet_search(self.plc, self.merged, self.opts),
         };
-        if self.search_splits != self.subsegs.steiner_points {
-            self.search_splits = self.subsegs.steiner_points;
-            search.seg_ends = segment_ends(&self.subsegs, &self.cdt.dt.orig);
-        }
         // Room for a restart (for free points or flat tets' splits) in this pass.
         let restart_room = self.stats.restarts < MAX_FREE_RESTARTS
             && self.stats.work + self.facet_work < RESTART_WORK / 4;
@@ -788,9 +777,9 @@ impl<'a> Construction<'a> {
             // A face around such a point that lies on a facet beside its triangles (in the
             // slab of a facet far from flat) makes the construction start again instead,
             // with the points as input vertices.
-            let search = self.search.get_or_insert_with(|| {
-                flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
-            });
+            let search = self
+                .search
+                .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
             let covering = self
                 .free_in_place
                 .iter()
@@ -825,9 +814,9 @@ impl<'a> Construction<'a> {
             // Known, and too many (or none) for other constructions: no search needed.
             Some(known) if !(1..=MAX_RETRY_TETS).contains(&known.tets) => (known, Vec::new()),
             _ => {
-                let search = self.search.get_or_insert_with(|| {
-                    flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
-                });
+                let search = self
+                    .search
+                    .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
                 slivers::flat_left(&mut self.cdt, search, &mut self.carved, MAX_RETRY_TETS)
             }
         };
@@ -838,9 +827,9 @@ impl<'a> Construction<'a> {
                     .get(self.n_input)
                     .copied()
                     .filter(|&v| v != u32::MAX);
-                let search = self.search.get_or_insert_with(|| {
-                    flat_tet_search(plc, merged, &self.subsegs, &self.cdt, opts)
-                });
+                let search = self
+                    .search
+                    .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
                 v.is_some_and(|v| search.covering_face_around(&self.cdt, v, true))
             }
             _ => false,
@@ -879,14 +868,11 @@ fn count_update(cdt: &mut Cdt, in_place: &mut usize, stats: &mut PlcStats) {
 fn flat_tet_search<'a>(
     plc: &'a Plc,
     merged: &'a PreparedPlc,
-    subsegs: &segments::Subsegments,
-    cdt: &Cdt,
     opts: &PlcOptions,
 ) -> slivers::Search<'a> {
     slivers::Search {
         prep: merged,
         input: &plc.points,
-        seg_ends: segment_ends(subsegs, &cdt.dt.orig),
         domain: slivers::Domain {
             holes: &plc.holes,
             regions: &plc.regions,
@@ -894,19 +880,6 @@ fn flat_tet_search<'a>(
         },
         index: Default::default(),
     }
-}
-
-/// The input ends of the segment of each Steiner point on one (`orig` maps vertices to
-/// input indices), which name the facets a flat tet of such points may lie on.
-fn segment_ends(subsegs: &segments::Subsegments, orig: &[u32]) -> FxHashMap<VertexId, [u32; 2]> {
-    let mut seg_ends: FxHashMap<VertexId, [u32; 2]> = FxHashMap::default();
-    for chain in subsegs.chains.iter().filter(|c| c.len() > 2) {
-        let ends = [chain[0], chain[chain.len() - 1]].map(|x| orig[x as usize]);
-        for &v in &chain[1..chain.len() - 1] {
-            seg_ends.insert(v, ends);
-        }
-    }
-    seg_ends
 }
 
 /// For each flat tet, the split of its longest edge that is a subsegment, as (segment,

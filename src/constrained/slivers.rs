@@ -13,7 +13,7 @@ use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, diagonal, dot, longest_edge2, sub, Point};
 use crate::mesh::VertexId;
 use crate::plc::Region;
-use rustc_hash::FxHashMap;
+use crate::precheck::bvh::{Aabb, Bvh};
 use std::cell::OnceCell;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
@@ -50,12 +50,10 @@ pub(crate) struct Domain<'a> {
 }
 
 /// What the search for tets on facets needs besides the CDT: the facets as merged
-/// (`prep`), the input points, the input ends of the segment of each Steiner point on
-/// one (which name the facets a tet of such points may lie on), and the domain.
+/// (`prep`), the input points, and the domain.
 pub(crate) struct Search<'a> {
     pub prep: &'a PreparedPlc,
     pub input: &'a [Point],
-    pub seg_ends: FxHashMap<VertexId, [u32; 2]>,
     pub domain: Domain<'a>,
     /// Which facets each input vertex is on, and the facets' slabs: made when first
     /// needed (a model without Steiner points never needs them).
@@ -68,6 +66,9 @@ pub(crate) struct FacetIndex {
     slabs: Vec<Option<Slab>>,
     /// The thickest slab's half-thickness: a tet thicker than twice it lies in none.
     tol_max: f64,
+    /// Each facet's slab as a box (empty without a slab), and a hierarchy over them.
+    boxes: Vec<Aabb>,
+    bvh: Bvh,
 }
 
 impl Search<'_> {
@@ -77,7 +78,16 @@ impl Search<'_> {
             let slabs: Vec<Option<Slab>> = (0..self.prep.facets.len())
                 .map(|fi| slab_of(self.prep, self.input, diag, fi))
                 .collect();
+            let boxes: Vec<Aabb> = slabs
+                .iter()
+                .map(|s| match s {
+                    Some(s) => [s.lo.map(|x| x - s.tol), s.hi.map(|x| x + s.tol)],
+                    None => [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]],
+                })
+                .collect();
             FacetIndex {
+                bvh: Bvh::build(&boxes),
+                boxes,
                 on_facets: crate::mesh::VertexLists::new(
                     self.input.len(),
                     self.prep
@@ -108,10 +118,17 @@ impl Search<'_> {
     /// facets' rings, Steiner points by the facets' slabs. The lowest such facet is
     /// named.
     fn facet_of(&self, cdt: &Cdt, v: [VertexId; 4]) -> Option<u32> {
+        self.facet_holding(
+            &v.map(|x| cdt.dt.points[x as usize]),
+            v.map(|x| cdt.dt.orig[x as usize]),
+        )
+    }
+
+    /// [`Self::facet_of`] for points `p` whose input indices are `o` (Steiner points have
+    /// indices past the input's).
+    fn facet_holding(&self, p: &[Point; 4], o: [u32; 4]) -> Option<u32> {
         let n_input = self.input.len();
         let index = self.index();
-        let p = v.map(|x| cdt.dt.points[x as usize]);
-        let o = v.map(|x| cdt.dt.orig[x as usize]);
         let on = |i: usize, f: u32| -> bool {
             if (o[i] as usize) < n_input {
                 index.on_facets.of(o[i]).contains(&f)
@@ -132,20 +149,21 @@ impl Search<'_> {
                 .copied()
                 .find(|&f| (0..4).all(|i| on(i, f)));
         }
-        // A tet of Steiner points on segments (between nearly parallel segments) has no
-        // input vertex to name its facet: the segments' ends do. The lowest facet of
-        // theirs that holds all four is taken (each list is increasing).
+        // A tet of Steiner points has no input vertex to name its facet: any facet whose
+        // slab holds all four may, even one none of their segments touches (a bent
+        // group's slab can hold the split points of a neighbouring fan). The lowest is
+        // named.
+        let bbox: Aabb = [
+            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::INFINITY, f64::min)),
+            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::NEG_INFINITY, f64::max)),
+        ];
         let mut best: Option<u32> = None;
-        for x in v.iter().filter_map(|x| self.seg_ends.get(x)).flatten() {
-            for &f in index.on_facets.of(*x) {
-                if best.is_some_and(|b| b <= f) {
-                    break;
-                }
-                if (0..4).all(|i| on(i, f)) {
-                    best = Some(f);
-                }
+        index.bvh.query(&index.boxes, &bbox, |f| {
+            let f = f as u32;
+            if best.is_none_or(|b| f < b) && (0..4).all(|i| on(i, f)) {
+                best = Some(f);
             }
-        }
+        });
         best
     }
 
@@ -739,7 +757,6 @@ mod tests {
         let search = Search {
             prep: &prep,
             input: &plc.points,
-            seg_ends: FxHashMap::default(),
             domain: Domain {
                 holes: &[],
                 regions: &[],
@@ -763,6 +780,66 @@ mod tests {
         for (x, y) in [(0.2, 0.2), (2.5, 2.5), (1.4, 1.4)] {
             assert!(!search.face_inside_facet(holed, &tri(x, y, 5.0)));
         }
+    }
+
+    #[test]
+    fn a_tet_of_steiner_points_is_named_by_any_slab_that_holds_it() {
+        // Two quads, each slightly bent (one corner 0.01 up), far apart: slabs 0.04 thick
+        // at z = 0 and z = 10. No segment of either passes near the Steiner points below,
+        // which only a slab can name.
+        let quad = |z: f64| {
+            [
+                [0.0, 0.0, z],
+                [4.0, 0.0, z],
+                [4.0, 4.0, z + 0.01],
+                [0.0, 4.0, z],
+            ]
+        };
+        let plc = crate::plc::Plc {
+            points: quad(0.0).into_iter().chain(quad(10.0)).collect(),
+            facets: vec![
+                crate::plc::Facet {
+                    polygons: vec![(0..4).collect()],
+                    ..Default::default()
+                },
+                crate::plc::Facet {
+                    polygons: vec![(4..8).collect()],
+                    ..Default::default()
+                },
+            ],
+            ..Default::default()
+        };
+        let prep = super::super::prepare::prepare(&plc, true).unwrap();
+        let search = Search {
+            prep: &prep,
+            input: &plc.points,
+            domain: Domain {
+                holes: &[],
+                regions: &[],
+                keep_hull: false,
+            },
+            index: Default::default(),
+        };
+        let top = prep
+            .facets
+            .iter()
+            .position(|f| plc.points[f.rings[0][0] as usize][2] == 10.0)
+            .unwrap() as u32;
+        let tet = |z: f64| {
+            [
+                [1.0, 1.0, z],
+                [2.0, 1.0, z],
+                [1.0, 2.0, z],
+                [2.0, 2.0, z + 0.005],
+            ]
+        };
+        let steiner = [8, 9, 10, 11];
+        assert_eq!(search.facet_holding(&tet(10.0), steiner), Some(top));
+        assert_eq!(search.facet_holding(&tet(10.5), steiner), None);
+        assert_eq!(search.facet_holding(&tet(5.0), steiner), None);
+        // With an input vertex, its own facets decide.
+        assert_eq!(search.facet_holding(&tet(10.0), [8, 9, 10, 1]), None);
+        assert_eq!(search.facet_holding(&tet(10.0), [8, 9, 10, 5]), Some(top));
     }
 
     #[test]
