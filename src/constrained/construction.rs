@@ -29,7 +29,7 @@ use std::time::Instant;
 /// triangles leave many, which no single point removes).
 const MAX_RETRY_TETS: usize = 4;
 
-/// Restarts after which flat tets no longer get free points (see [`slivers`]).
+/// Rounds of free points (see [`slivers`]) in one construction.
 const MAX_FREE_ROUNDS: usize = 12;
 
 /// Work ([`slivers::free_points`]) that the search for free points may do in one
@@ -40,9 +40,21 @@ const FREE_SEARCH_WORK_PER_SLOT: u64 = 64;
 const FREE_SEARCH_WORK: u64 = 1_000_000;
 
 /// Restarts after which free points the CDT refuses and flat-tet splits no longer start
-/// the construction again: each costs a whole construction, and past a few they do not
-/// converge (on fans of needle triangles every restart finds new flat tets).
-const MAX_FREE_RESTARTS: usize = 3;
+/// the construction again: each costs a whole construction. Fans of needle triangles
+/// need many: each restart's splits settle some flat tets and leave fewer new ones
+/// (`112544.off` takes 11 to 13), but the count does not fall at every restart.
+const MAX_FREE_RESTARTS: usize = 20;
+const _: () = assert!(MAX_FREE_RESTARTS + 2 < super::MAX_RESTARTS);
+
+/// Restarts after which flat tets' splits cut pieces to length at once, and flat tets
+/// covering a facet get them too (before, a piece is halved).
+const LENS_RESTARTS: usize = 3;
+
+/// A piece split for a flat tet is cut into parts no longer than this many times the
+/// distance from it to the tet's nearest other vertex (see [`flat_tet_splits`])...
+const LENS_PIECE: f64 = 0.9;
+/// ... and into at most this many.
+const MAX_LENS_PARTS: usize = 64;
 
 /// A finished CDT, before carving and output.
 pub(super) struct Built {
@@ -59,14 +71,26 @@ pub(super) struct Built {
     /// Whether a face around the first earlier point (a retry's own point) lies on a
     /// facet beside its triangles.
     pub first_point_covers: bool,
+    /// The flat tets that lie on no facet but cover one with a face (counted only after
+    /// a restart, when constructions are compared).
+    pub covering: usize,
+}
+
+impl Built {
+    /// How far it is from a mesh without tets on facets: the fewer the better.
+    pub fn tets_on_facets(&self) -> usize {
+        self.flat_left.tets + self.covering
+    }
 }
 
 /// How a construction ended.
 pub(super) enum Attempt {
     /// With a CDT.
     Done(Box<Built>),
-    /// Asking for another, with these points and splits.
-    Restart(Vec<FacetPoint>, Vec<SegmentSplit>),
+    /// Asking for another, with these points and splits; with its own complete CDT when
+    /// the points and splits only improve it (free points and flat tets' splits), to be
+    /// taken if no later construction does better.
+    Restart(Vec<FacetPoint>, Vec<SegmentSplit>, Option<Box<Built>>),
 }
 
 /// One construction from scratch: Delaunay, segments, facets. `prep` is the PLC as
@@ -173,6 +197,8 @@ struct Construction<'a> {
     restart_instead: Option<Vec<FacetPoint>>,
     /// Whether refused free points have given way to subsegment splits.
     free_splits: bool,
+    /// Whether the CDT is complete: facets recovered, free points put in.
+    complete: bool,
     free_rounds: usize,
     budget: Option<u64>,
     /// The carving of the CDT as it stands, while nothing changes it.
@@ -323,6 +349,7 @@ impl<'a> Construction<'a> {
             free_in_place: Vec::new(),
             restart_instead: None,
             free_splits: false,
+            complete: false,
             free_rounds: 0,
             budget: None,
             carved: None,
@@ -581,6 +608,7 @@ impl<'a> Construction<'a> {
     /// left on facets, then splits for those the points cannot remove. Whether facets
     /// were taken out for free points, to be recovered again.
     fn settle_flat_tets(&mut self) -> Result<bool, Error> {
+        self.complete = false;
         self.stats.facet_secs = self.t_facets.elapsed().as_secs_f64() - self.stats.surface_secs;
         self.facet_work = self.cdt.work.get();
         self.carved = None;
@@ -592,7 +620,7 @@ impl<'a> Construction<'a> {
         self.flat_left = None;
         if !(self.steiner.is_empty()
             && self.splits.is_empty()
-            && self.stats.restarts < MAX_FREE_ROUNDS)
+            && self.stats.restarts <= MAX_FREE_RESTARTS)
         {
             return Ok(false);
         }
@@ -606,20 +634,35 @@ impl<'a> Construction<'a> {
             && self.stats.work + self.facet_work < RESTART_WORK / 4;
         let rounds = self.free_point_rounds(&search, restart_room);
         self.search = Some(search);
-        let Some(stuck) = rounds? else {
+        let Some(mut stuck) = rounds? else {
             return Ok(true);
         };
+        // Facets are recovered and free points put in: a CDT, whatever comes next.
+        self.complete = true;
         self.stats.steiner_points += self.stats.free_steiner_points;
 
-        // A flat tet whose circumsphere lies within its facet's slab spans a gap between
-        // segments closer than the slab is thick. Its size, not its shape, makes it flat:
-        // splitting its longest subsegment makes the tets there smaller against the gap.
-        // Like free points, they only improve a valid CDT: only while the restart they
-        // cost stays well within the bounds on restarts and their work.
-        let affordable =
-            restart_room && 2 * (self.presplits.len() + stuck.len()) <= max_facet_points(self.plc);
-        if self.steiner.is_empty() && affordable {
-            let more = flat_tet_splits(&self.cdt, &stuck, &self.seg_of, &self.subsegs);
+        // A flat tet that no free point removes is folded over a subsegment between
+        // nearly coplanar facets, its sphere centred beyond the surface, or spans a gap
+        // between segments closer than a facet's slab is thick. Splitting a subsegment of
+        // it (see [`flat_tet_splits`]) changes that. Like free points, the splits only
+        // improve a valid CDT: only while the restart they cost stays well within the
+        // bounds on restarts, their work and the Steiner points on segments.
+        if !(self.steiner.is_empty() && restart_room) {
+            return Ok(false);
+        }
+        // Past the first restarts, the flat tets left are the stubborn kind: those on no
+        // facet that cover one with a face need splits too, and pieces are cut to length
+        // at once.
+        let lens = self.stats.restarts >= LENS_RESTARTS;
+        if let (true, Some(search)) = (lens, self.search.as_ref()) {
+            let covering = slivers::covering_flat_tets(&mut self.cdt, search, &mut self.carved);
+            if debug() {
+                eprintln!("flat tets covering a facet {covering:?}");
+            }
+            stuck.extend(covering);
+        }
+        let more = flat_tet_splits(&self.cdt, &stuck, &self.seg_of, &self.subsegs, lens);
+        if 2 * (self.presplits.len() + more.len()) <= max_facet_points(self.plc) {
             self.splits.extend(more);
             if debug() && !self.splits.is_empty() {
                 eprintln!("flat tets {stuck:?}: splits {:?}", self.splits);
@@ -808,7 +851,26 @@ impl<'a> Construction<'a> {
                     steiner.push(p);
                 }
             }
-            return Ok(Attempt::Restart(steiner, splits));
+            let fallback = if self.complete && steiner.iter().all(|p| p.0 == FREE_POINT) {
+                let search = self
+                    .search
+                    .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
+                let (flat_left, _) = slivers::flat_left(&mut self.cdt, search, &mut self.carved, 0);
+                let covering =
+                    slivers::covering_flat_tets(&mut self.cdt, search, &mut self.carved).len();
+                Some(Box::new(Built {
+                    cdt: self.cdt,
+                    seg_markers: self.seg_markers,
+                    carved: self.carved,
+                    flat_left,
+                    retry_points: Vec::new(),
+                    first_point_covers: false,
+                    covering,
+                }))
+            } else {
+                None
+            };
+            return Ok(Attempt::Restart(steiner, splits, fallback));
         }
         let (flat_left, retry_points) = match self.flat_left {
             // Known, and too many (or none) for other constructions: no search needed.
@@ -834,6 +896,14 @@ impl<'a> Construction<'a> {
             }
             _ => false,
         };
+        let covering = if self.stats.restarts > 0 {
+            let search = self
+                .search
+                .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
+            slivers::covering_flat_tets(&mut self.cdt, search, &mut self.carved).len()
+        } else {
+            0
+        };
         Ok(Attempt::Done(Box::new(Built {
             cdt: self.cdt,
             seg_markers: self.seg_markers,
@@ -841,7 +911,19 @@ impl<'a> Construction<'a> {
             flat_left,
             retry_points,
             first_point_covers,
+            covering,
         })))
+    }
+}
+
+/// Into how many equal parts a piece `len` long is cut so that a vertex `d` from its line
+/// lies in no part's diametral sphere: parts no longer than [`LENS_PIECE`] times `d`, at
+/// least two, at most [`MAX_LENS_PARTS`].
+fn lens_parts(len: f64, d: f64) -> usize {
+    if d > 0.0 && d.is_finite() && len.is_finite() {
+        ((len / (LENS_PIECE * d)).ceil() as usize).clamp(2, MAX_LENS_PARTS)
+    } else {
+        2
     }
 }
 
@@ -882,32 +964,71 @@ fn flat_tet_search<'a>(
     }
 }
 
-/// For each flat tet, the split of its longest edge that is a subsegment, as (segment,
-/// parameter along it).
+/// For each flat tet that no free point removes, splits of one subsegment near it: its
+/// longest edge that is one, or else the longest subsegment at one of its vertices. The
+/// piece is cut into equal parts no longer than `LENS_PIECE` times the distance from its
+/// line to the tet's nearest other vertex, so that vertex no longer lies in the
+/// diametral sphere of any part: then the subfaces on either side of the piece are
+/// Delaunay across it, and a tet folded over it has its sphere's centre in the domain,
+/// where a free point reaches it (one midpoint split at a time took a restart per
+/// halving, more than the restarts allow).
 fn flat_tet_splits(
     cdt: &Cdt,
     stuck: &[[VertexId; 4]],
     seg_of: &FxHashMap<(VertexId, VertexId), usize>,
     subsegs: &segments::Subsegments,
+    lens: bool,
 ) -> Vec<(usize, f64)> {
+    use crate::geom::{cross, norm, sub};
+    let pt = |x: VertexId| cdt.dt.points[x as usize];
+    let len = |&(a, b): &(VertexId, VertexId)| norm(&sub(&pt(a), &pt(b)));
+    // The subsegments at each vertex on a segment.
+    let mut at: FxHashMap<VertexId, Vec<(VertexId, VertexId)>> = FxHashMap::default();
+    if stuck.iter().any(|v| {
+        !crate::mesh::EDGE_VERTS
+            .iter()
+            .any(|&(i, j)| seg_of.contains_key(&edge_key(v[i], v[j])))
+    }) {
+        for &e in seg_of.keys() {
+            at.entry(e.0).or_default().push(e);
+            at.entry(e.1).or_default().push(e);
+        }
+    }
     let mut out: Vec<(usize, f64)> = Vec::new();
     let mut split: FxHashSet<(VertexId, VertexId)> = FxHashSet::default();
     for v in stuck {
-        let len2 = |&(a, b): &(VertexId, VertexId)| {
-            let d = crate::geom::sub(&cdt.dt.points[a as usize], &cdt.dt.points[b as usize]);
-            crate::geom::dot(&d, &d)
-        };
-        let longest = crate::mesh::EDGE_VERTS
+        let own = crate::mesh::EDGE_VERTS
             .iter()
             .map(|&(i, j)| edge_key(v[i], v[j]))
             .filter(|e| seg_of.contains_key(e))
-            .max_by(|x, y| len2(x).total_cmp(&len2(y)));
-        if let Some(e) = longest {
-            if split.insert(e) {
-                let seg = seg_of[&e];
-                out.push((seg, midpoint_parameter(cdt, &subsegs.chains[seg], e.0, e.1)));
-            }
+            .max_by(|x, y| len(x).total_cmp(&len(y)));
+        let e = own.or_else(|| {
+            v.iter()
+                .filter_map(|x| at.get(x))
+                .flatten()
+                .copied()
+                .max_by(|x, y| len(x).total_cmp(&len(y)))
+        });
+        let Some(e) = e else { continue };
+        if !split.insert(e) {
+            continue;
         }
+        let (pa, pb) = (pt(e.0), pt(e.1));
+        let l = len(&e);
+        let ab = sub(&pb, &pa);
+        let d = v
+            .iter()
+            .filter(|&&x| x != e.0 && x != e.1)
+            .map(|&x| norm(&cross(&ab, &sub(&pt(x), &pa))) / l)
+            .fold(f64::INFINITY, f64::min);
+        let parts = if lens { lens_parts(l, d) } else { 2 };
+        let seg = seg_of[&e];
+        let chain = &subsegs.chains[seg];
+        let (s0, s1) = (
+            super::in_place::parameter(cdt, chain, e.0),
+            super::in_place::parameter(cdt, chain, e.1),
+        );
+        out.extend((1..parts).map(|i| (seg, s0 + (s1 - s0) * i as f64 / parts as f64)));
     }
     out
 }
@@ -1079,4 +1200,29 @@ fn regions_of(
         out.push(region);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_piece_is_cut_so_that_a_near_vertex_encroaches_upon_no_part() {
+        for (len, d) in [(1.0, 0.1), (0.137, 0.0043), (1.0, 0.6), (0.00098, 1.24e-5)] {
+            let k = lens_parts(len, d);
+            // The vertex is `d` from the line, a part's diametral sphere `part / 2` from it.
+            let part = len / k as f64;
+            assert!(part / 2.0 < d && k >= 2, "{len} {d}: {k} parts");
+            if k > 2 && k < MAX_LENS_PARTS {
+                assert!(
+                    len / (k - 1) as f64 > LENS_PIECE * d,
+                    "{len} {d}: {k} parts"
+                );
+            }
+        }
+        assert_eq!(lens_parts(1.0, 0.0), 2);
+        assert_eq!(lens_parts(1.0, 10.0), 2);
+        assert_eq!(lens_parts(1.0, 1e-9), MAX_LENS_PARTS);
+        assert_eq!(lens_parts(f64::INFINITY, 1.0), 2);
+    }
 }

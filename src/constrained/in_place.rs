@@ -512,7 +512,7 @@ const MAX_GROUP: usize = 16;
 
 /// The parameter of vertex `x` along the segment whose chain is `chain` (0 at its first
 /// end, 1 at its last), of its projection on the line through them.
-fn parameter(cdt: &Cdt, chain: &[VertexId], x: VertexId) -> f64 {
+pub(super) fn parameter(cdt: &Cdt, chain: &[VertexId], x: VertexId) -> f64 {
     let p = |x: VertexId| cdt.dt.points[x as usize];
     let (a, b) = chain_ends(chain);
     let (pa, pb) = (p(a), p(b));

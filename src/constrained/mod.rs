@@ -308,6 +308,10 @@ pub fn mesh_plc_with_progress(
     // Set when a retry's construction fails or does no better: the next point is tried,
     // or, when none is left, the first construction is taken.
     let mut retry_failed = false;
+    // The complete construction with the fewest tets on facets among those that asked for
+    // another only to improve on it: taken if the restarts end no better, or, if it left
+    // none, over their bounds (they only improve a valid CDT).
+    let mut best: Option<(Box<Built>, PlcStats, Vec<FacetPoint>)> = None;
     let built = loop {
         if std::mem::take(&mut retry_failed) {
             if let Some(state) = retry.as_mut().and_then(|r| r.next(&stats0)) {
@@ -350,6 +354,7 @@ pub fn mesh_plc_with_progress(
                 if sources.is_empty() || sources.iter().all(|s| keep_apart.contains(s)) {
                     return Err(MeshError::Failed(msg[UNFLAT_GROUP.len()..].to_string()).into());
                 }
+                best = None;
                 keep_apart.extend(sources);
                 keep_apart.sort_unstable();
                 keep_apart.dedup();
@@ -376,9 +381,14 @@ pub fn mesh_plc_with_progress(
                 (facet_points, presplits, first_work, stats) = without_updates(&stats0);
                 continue;
             }
-            Err(Error::Mesh(MeshError::WorkBound)) => {
-                return Err(still_conflicting(facet_points.len()));
-            }
+            Err(Error::Mesh(MeshError::WorkBound)) => match best.take() {
+                Some((b, mut st, fp)) if retry.is_none() && b.tets_on_facets() == 0 => {
+                    st.restarts = stats.restarts;
+                    (stats, facet_points) = (st, fp);
+                    break b;
+                }
+                _ => return Err(still_conflicting(facet_points.len())),
+            },
             Err(e) => return Err(e),
         };
         match outcome {
@@ -396,7 +406,21 @@ pub fn mesh_plc_with_progress(
                     (facet_points, presplits, stats, first_work) = r.start(&stats0);
                     continue;
                 }
-                None => break built,
+                None => match best.take() {
+                    Some((b, mut st, fp)) if b.tets_on_facets() < built.tets_on_facets() => {
+                        if debug() {
+                            eprintln!(
+                                "{} tets on facets left: an earlier construction's {} taken",
+                                built.tets_on_facets(),
+                                b.tets_on_facets()
+                            );
+                        }
+                        st.restarts = stats.restarts;
+                        (stats, facet_points) = (st, fp);
+                        break b;
+                    }
+                    _ => break built,
+                },
                 Some(r) => {
                     if debug() {
                         eprintln!(
@@ -411,8 +435,16 @@ pub fn mesh_plc_with_progress(
                     continue;
                 }
             },
-            Attempt::Restart(more, splits) => {
+            Attempt::Restart(more, splits, fallback) => {
                 stats.restarts += 1;
+                if let Some(b) = fallback {
+                    if best
+                        .as_ref()
+                        .is_none_or(|x| b.tets_on_facets() < x.0.tets_on_facets())
+                    {
+                        best = Some((b, stats.clone(), facet_points.clone()));
+                    }
+                }
                 if stats.restarts == 1 {
                     first_work = stats.work;
                 }
@@ -429,6 +461,16 @@ pub fn mesh_plc_with_progress(
                     || facet_points.len() + more.len() + presplits.len() + splits.len()
                         > max_facet_points(plc)
                     || stats.work > restart_work_bound(first_work);
+                // Past the bounds, an earlier construction is taken only if it left no tets
+                // on facets; one that did is no mesh to succeed with.
+                let clean = best.as_ref().is_some_and(|b| b.0.tets_on_facets() == 0);
+                if (over_steiner || over_work) && retry.is_none() && clean {
+                    if let Some((b, mut st, fp)) = best.take() {
+                        st.restarts = stats.restarts;
+                        (stats, facet_points) = (st, fp);
+                        break b;
+                    }
+                }
                 if (over_steiner || over_work) && retry.is_some() {
                     retry_failed = true;
                     continue;
@@ -923,6 +965,7 @@ fn finish(
         flat_left: _,
         retry_points: _,
         first_point_covers: _,
+        covering: _,
     } = built;
     let t = Instant::now();
     let carved =

@@ -10,7 +10,7 @@ use super::cdt::Cdt;
 use super::prepare::{newell_normal, PreparedPlc};
 use crate::carve::{carve, containing_tet_near, Carved};
 use crate::geom::predicates::{insphere, orient3d};
-use crate::geom::{cross, diagonal, dot, longest_edge2, sub, Point};
+use crate::geom::{cross, diagonal, dot, longest_edge2, norm, sub, Point};
 use crate::mesh::VertexId;
 use crate::plc::Region;
 use crate::precheck::bvh::{Aabb, Bvh};
@@ -208,6 +208,84 @@ impl Search<'_> {
         })
     }
 
+    /// A facet that a face of tet `t` which is not a subface lies on, inside one of the
+    /// facet's polygons and covering more than a trace of it, if any.
+    fn covered_by_face_of(&self, cdt: &Cdt, t: crate::mesh::TetId) -> Option<u32> {
+        (0..4).filter(|&i| !cdt.is_subface(t, i)).find_map(|i| {
+            let f = cdt.dt.mesh.face_verts(t, i);
+            let fi = self.facet_of(cdt, [f[0], f[1], f[2], f[2]])?;
+            let slab = self.slab(fi as usize)?;
+            let q = f.map(|x| cdt.dt.points[x as usize]);
+            // The referee's tolerance on a facet's coverage, as in
+            // `covering_face_around`: a face standing across the slab covers nothing.
+            let n = cross(&sub(&q[1], &q[0]), &sub(&q[2], &q[0]));
+            let area = 0.5 * dot(&n, &slab.normal).abs();
+            (area > 1e-6 * self.facet_area(fi as usize, &slab.normal)
+                && self.face_on_a_polygon(fi as usize, &q))
+            .then_some(fi)
+        })
+    }
+
+    /// Whether triangle `q` lies on one of merged facet `fi`'s polygons as the referee
+    /// measures it: a sample point (its centroid, or halfway from it to a corner) near
+    /// the polygon's own plane and inside it seen along the polygon's own normal. Nearness
+    /// is the polygon's own flatness four times, and a five-hundredth of its size, for
+    /// a diagonal flipped across a merged neighbour.
+    fn face_on_a_polygon(&self, fi: usize, q: &[Point; 3]) -> bool {
+        let f = &self.prep.facets[fi];
+        if !f.holes.is_empty() {
+            return false;
+        }
+        let tiny = 1e-10 * diagonal(self.input);
+        let samples: Vec<Point> = [
+            [1.0 / 3.0; 3],
+            [0.5, 0.25, 0.25],
+            [0.25, 0.5, 0.25],
+            [0.25, 0.25, 0.5],
+        ]
+        .iter()
+        .map(|w| std::array::from_fn(|c| w[0] * q[0][c] + w[1] * q[1][c] + w[2] * q[2][c]))
+        .collect();
+        f.rings.iter().any(|ring| {
+            let n = newell_normal(self.input, ring);
+            let len = norm(&n);
+            if len == 0.0 {
+                return false;
+            }
+            let n = n.map(|x| x / len);
+            let pts: Vec<Point> = ring.iter().map(|&v| self.input[v as usize]).collect();
+            let k = pts.len() as f64;
+            let mean: Point = std::array::from_fn(|c| pts.iter().map(|p| p[c]).sum::<f64>() / k);
+            let flat = pts
+                .iter()
+                .map(|p| dot(&sub(p, &mean), &n).abs())
+                .fold(0.0, f64::max);
+            let lo: Point =
+                std::array::from_fn(|c| pts.iter().map(|p| p[c]).fold(f64::INFINITY, f64::min));
+            let hi: Point =
+                std::array::from_fn(|c| pts.iter().map(|p| p[c]).fold(f64::NEG_INFINITY, f64::max));
+            let t = tiny + 4.0 * flat + 0.002 * norm(&sub(&hi, &lo));
+            let ax = (0..3)
+                .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+                .unwrap_or(2);
+            let (i, j) = ((ax + 1) % 3, (ax + 2) % 3);
+            samples.iter().any(|w| {
+                let near = (0..3).all(|c| w[c] >= lo[c] - t && w[c] <= hi[c] + t)
+                    && dot(&sub(w, &mean), &n).abs() <= t;
+                let mut odd = false;
+                for (m, a) in pts.iter().enumerate() {
+                    let b = &pts[(m + 1) % pts.len()];
+                    if (a[j] > w[j]) != (b[j] > w[j])
+                        && w[i] < a[i] + (w[j] - a[j]) * (b[i] - a[i]) / (b[j] - a[j])
+                    {
+                        odd = !odd;
+                    }
+                }
+                near && odd
+            })
+        })
+    }
+
     /// Whether triangle `q`, near merged facet `fi`'s plane, lies inside one of its
     /// polygons, as the referee asks: its centroid or a point halfway from it to a corner
     /// inside one, seen along the facet's normal. The referee does not measure the
@@ -260,7 +338,8 @@ impl Search<'_> {
             .sum()
     }
 
-    /// Whether some tet around vertex `v` has all four vertices on one facet.
+    /// Whether some tet around vertex `v` has all four vertices on one facet, or is flat
+    /// and covers one with a face (see [`Self::covered_by_face_of`]).
     pub(crate) fn on_facet_around(&self, cdt: &Cdt, v: VertexId) -> bool {
         let mut star = Vec::new();
         cdt.dt.star(v, &mut star);
@@ -274,6 +353,8 @@ impl Search<'_> {
                 );
             }
             f.is_some()
+                || (is_flat(&cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]))
+                    && self.covered_by_face_of(cdt, t).is_some())
         })
     }
 }
@@ -409,6 +490,47 @@ pub(crate) fn flat_left(
         Vec::new()
     };
     (left, retry)
+}
+
+/// The flat tets that carving keeps which lie on no facet but have a face, not a
+/// subface, on one (see [`Search::covered_by_face_of`]): a facet's triangles and that
+/// face both cover it. Most hug a crease between nearly coplanar facets, with one
+/// vertex just off the facet's box or slab, so that they are no shims and the
+/// free-point search does not look at them. `carved` as in [`free_points`].
+pub(crate) fn covering_flat_tets(
+    cdt: &mut Cdt,
+    search: &Search<'_>,
+    carved: &mut Option<Carved>,
+) -> Vec<[VertexId; 4]> {
+    let kept = carved
+        .get_or_insert_with(|| {
+            carve(
+                cdt,
+                search.domain.holes,
+                search.domain.regions,
+                search.domain.keep_hull,
+            )
+        })
+        .kept_mask(cdt.dt.mesh.num_slots());
+    let n_input = search.input.len();
+    cdt.dt
+        .mesh
+        .live_tets()
+        .filter(|&t| kept[t as usize] && !cdt.is_ghost(t))
+        .filter_map(|t| {
+            let v = cdt.dt.mesh.verts(t);
+            if v.iter()
+                .all(|&x| (cdt.dt.orig[x as usize] as usize) < n_input)
+            {
+                return None;
+            }
+            let p = v.map(|x| cdt.dt.points[x as usize]);
+            if !is_flat(&p) || !search.may_lie_in_a_slab(&p) || search.facet_of(cdt, v).is_some() {
+                return None;
+            }
+            search.covered_by_face_of(cdt, t).map(|_| v)
+        })
+        .collect()
 }
 
 /// Free vertices that remove the tets lying on one facet, a list for each such tet, and
@@ -840,6 +962,14 @@ mod tests {
         // With an input vertex, its own facets decide.
         assert_eq!(search.facet_holding(&tet(10.0), [8, 9, 10, 1]), None);
         assert_eq!(search.facet_holding(&tet(10.0), [8, 9, 10, 5]), Some(top));
+        // A face covers the facet where it lies near the polygon's own plane (within a
+        // five-hundredth of its size, here 0.011, plus its flatness) and inside it.
+        let top = top as usize;
+        let face = |x: f64, z: f64| [[x, 1.0, z], [x + 1.0, 1.0, z], [x, 2.0, z]];
+        assert!(search.face_on_a_polygon(top, &face(1.0, 10.0)));
+        assert!(search.face_on_a_polygon(top, &face(1.0, 10.012)));
+        assert!(!search.face_on_a_polygon(top, &face(1.0, 10.2)));
+        assert!(!search.face_on_a_polygon(top, &face(5.0, 10.0)));
     }
 
     #[test]
