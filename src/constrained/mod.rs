@@ -311,7 +311,7 @@ pub fn mesh_plc_with_progress(
     // The complete construction with the fewest tets on facets among those that asked for
     // another only to improve on it: taken if the restarts end no better, or, if it left
     // none, over their bounds (they only improve a valid CDT).
-    let mut best: Option<(Box<Built>, PlcStats, Vec<FacetPoint>)> = None;
+    let mut best: Option<Kept> = None;
     let built = loop {
         if std::mem::take(&mut retry_failed) {
             if let Some(state) = retry.as_mut().and_then(|r| r.next(&stats0)) {
@@ -382,10 +382,8 @@ pub fn mesh_plc_with_progress(
                 continue;
             }
             Err(Error::Mesh(MeshError::WorkBound)) => match best.take() {
-                Some((b, mut st, fp)) if retry.is_none() && b.tets_on_facets() == 0 => {
-                    st.restarts = stats.restarts;
-                    (stats, facet_points) = (st, fp);
-                    break b;
+                Some(b) if retry.is_none() && b.0.tets_on_facets() == 0 => {
+                    break take_best(b, &mut stats, &mut facet_points);
                 }
                 _ => return Err(still_conflicting(facet_points.len())),
             },
@@ -407,17 +405,15 @@ pub fn mesh_plc_with_progress(
                     continue;
                 }
                 None => match best.take() {
-                    Some((b, mut st, fp)) if b.tets_on_facets() < built.tets_on_facets() => {
+                    Some(b) if b.0.tets_on_facets() < built.tets_on_facets() => {
                         if debug() {
                             eprintln!(
                                 "{} tets on facets left: an earlier construction's {} taken",
                                 built.tets_on_facets(),
-                                b.tets_on_facets()
+                                b.0.tets_on_facets()
                             );
                         }
-                        st.restarts = stats.restarts;
-                        (stats, facet_points) = (st, fp);
-                        break b;
+                        break take_best(b, &mut stats, &mut facet_points);
                     }
                     _ => break built,
                 },
@@ -465,10 +461,8 @@ pub fn mesh_plc_with_progress(
                 // on facets; one that did is no mesh to succeed with.
                 let clean = best.as_ref().is_some_and(|b| b.0.tets_on_facets() == 0);
                 if (over_steiner || over_work) && retry.is_none() && clean {
-                    if let Some((b, mut st, fp)) = best.take() {
-                        st.restarts = stats.restarts;
-                        (stats, facet_points) = (st, fp);
-                        break b;
+                    if let Some(b) = best.take() {
+                        break take_best(b, &mut stats, &mut facet_points);
                     }
                 }
                 if (over_steiner || over_work) && retry.is_some() {
@@ -603,6 +597,23 @@ struct Retry {
     points: Vec<Point>,
     /// The one being tried.
     next: usize,
+}
+
+/// A complete construction kept in case later ones do no better: its CDT, its figures
+/// and the points it started from.
+type Kept = (Box<Built>, PlcStats, Vec<FacetPoint>);
+
+/// Takes kept construction `kept` as the outcome: its figures and points replace the
+/// current ones, but the restarts made since are still counted.
+fn take_best(
+    (built, mut kept_stats, kept_points): Kept,
+    stats: &mut PlcStats,
+    facet_points: &mut Vec<FacetPoint>,
+) -> Box<Built> {
+    kept_stats.restarts = stats.restarts;
+    *stats = kept_stats;
+    *facet_points = kept_points;
+    built
 }
 
 /// What a construction starts from: its points, splits, figures and first work.

@@ -237,15 +237,7 @@ impl Search<'_> {
             return false;
         }
         let tiny = 1e-10 * diagonal(self.input);
-        let samples: Vec<Point> = [
-            [1.0 / 3.0; 3],
-            [0.5, 0.25, 0.25],
-            [0.25, 0.5, 0.25],
-            [0.25, 0.25, 0.5],
-        ]
-        .iter()
-        .map(|w| std::array::from_fn(|c| w[0] * q[0][c] + w[1] * q[1][c] + w[2] * q[2][c]))
-        .collect();
+        let samples = face_samples(q);
         f.rings.iter().any(|ring| {
             let n = newell_normal(self.input, ring);
             let len = norm(&n);
@@ -253,35 +245,22 @@ impl Search<'_> {
                 return false;
             }
             let n = n.map(|x| x / len);
-            let pts: Vec<Point> = ring.iter().map(|&v| self.input[v as usize]).collect();
-            let k = pts.len() as f64;
-            let mean: Point = std::array::from_fn(|c| pts.iter().map(|p| p[c]).sum::<f64>() / k);
-            let flat = pts
-                .iter()
-                .map(|p| dot(&sub(p, &mean), &n).abs())
+            let pts = || ring.iter().map(|&v| self.input[v as usize]);
+            let k = ring.len() as f64;
+            let mean: Point = std::array::from_fn(|c| pts().map(|p| p[c]).sum::<f64>() / k);
+            let flat = pts()
+                .map(|p| dot(&sub(&p, &mean), &n).abs())
                 .fold(0.0, f64::max);
             let lo: Point =
-                std::array::from_fn(|c| pts.iter().map(|p| p[c]).fold(f64::INFINITY, f64::min));
+                std::array::from_fn(|c| pts().map(|p| p[c]).fold(f64::INFINITY, f64::min));
             let hi: Point =
-                std::array::from_fn(|c| pts.iter().map(|p| p[c]).fold(f64::NEG_INFINITY, f64::max));
+                std::array::from_fn(|c| pts().map(|p| p[c]).fold(f64::NEG_INFINITY, f64::max));
             let t = tiny + 4.0 * flat + 0.002 * norm(&sub(&hi, &lo));
-            let ax = (0..3)
-                .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
-                .unwrap_or(2);
-            let (i, j) = ((ax + 1) % 3, (ax + 2) % 3);
+            let axes = projection_axes(&n);
             samples.iter().any(|w| {
-                let near = (0..3).all(|c| w[c] >= lo[c] - t && w[c] <= hi[c] + t)
-                    && dot(&sub(w, &mean), &n).abs() <= t;
-                let mut odd = false;
-                for (m, a) in pts.iter().enumerate() {
-                    let b = &pts[(m + 1) % pts.len()];
-                    if (a[j] > w[j]) != (b[j] > w[j])
-                        && w[i] < a[i] + (w[j] - a[j]) * (b[i] - a[i]) / (b[j] - a[j])
-                    {
-                        odd = !odd;
-                    }
-                }
-                near && odd
+                (0..3).all(|c| w[c] >= lo[c] - t && w[c] <= hi[c] + t)
+                    && dot(&sub(w, &mean), &n).abs() <= t
+                    && inside_ring(self.input, ring, axes, w)
             })
         })
     }
@@ -295,38 +274,12 @@ impl Search<'_> {
         if !f.holes.is_empty() {
             return false;
         }
-        let ax = (0..3)
-            .max_by(|&a, &b| f.normal[a].abs().total_cmp(&f.normal[b].abs()))
-            .unwrap_or(2);
-        let (i, j) = ((ax + 1) % 3, (ax + 2) % 3);
-        let inside = |w: [f64; 2]| {
-            f.rings.iter().any(|ring| {
-                let mut odd = false;
-                for (k, &x) in ring.iter().enumerate() {
-                    let a = self.input[x as usize];
-                    let b = self.input[ring[(k + 1) % ring.len()] as usize];
-                    if (a[j] > w[1]) != (b[j] > w[1])
-                        && w[0] < a[i] + (w[1] - a[j]) * (b[i] - a[i]) / (b[j] - a[j])
-                    {
-                        odd = !odd;
-                    }
-                }
-                odd
-            })
-        };
-        let at = |wt: [f64; 3]| {
-            let p = |c: usize| wt[0] * q[0][c] + wt[1] * q[1][c] + wt[2] * q[2][c];
-            [p(i), p(j)]
-        };
-        let third = 1.0 / 3.0;
-        [
-            [third, third, third],
-            [0.5, 0.25, 0.25],
-            [0.25, 0.5, 0.25],
-            [0.25, 0.25, 0.5],
-        ]
-        .into_iter()
-        .any(|wt| inside(at(wt)))
+        let axes = projection_axes(&f.normal);
+        face_samples(q).iter().any(|w| {
+            f.rings
+                .iter()
+                .any(|ring| inside_ring(self.input, ring, axes, w))
+        })
     }
 
     /// The area of merged facet `fi` projected on `normal`.
@@ -453,16 +406,7 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
     }
     // Only kept tets matter, and the carving is needed anyway (the output reuses it):
     // tets outside the domain, often many, are dropped here.
-    let kept = carved
-        .get_or_insert_with(|| {
-            carve(
-                cdt,
-                search.domain.holes,
-                search.domain.regions,
-                search.domain.keep_hull,
-            )
-        })
-        .kept_mask(cdt.dt.mesh.num_slots());
+    let kept = kept_mask(cdt, search, carved);
     let tets: Vec<_> = tets.into_iter().filter(|x| kept[x.0 as usize]).collect();
     if super::debug() {
         eprintln!("tets on facets {tets:?}");
@@ -492,6 +436,21 @@ pub(crate) fn flat_left(
     (left, retry)
 }
 
+/// Which tet slots carving keeps; `carved` is the CDT's carving if known, and is set if
+/// made.
+fn kept_mask(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) -> Vec<bool> {
+    carved
+        .get_or_insert_with(|| {
+            carve(
+                cdt,
+                search.domain.holes,
+                search.domain.regions,
+                search.domain.keep_hull,
+            )
+        })
+        .kept_mask(cdt.dt.mesh.num_slots())
+}
+
 /// The flat tets that carving keeps which lie on no facet but have a face, not a
 /// subface, on one (see [`Search::covered_by_face_of`]): a facet's triangles and that
 /// face both cover it. Most hug a crease between nearly coplanar facets, with one
@@ -502,16 +461,7 @@ pub(crate) fn covering_flat_tets(
     search: &Search<'_>,
     carved: &mut Option<Carved>,
 ) -> Vec<[VertexId; 4]> {
-    let kept = carved
-        .get_or_insert_with(|| {
-            carve(
-                cdt,
-                search.domain.holes,
-                search.domain.regions,
-                search.domain.keep_hull,
-            )
-        })
-        .kept_mask(cdt.dt.mesh.num_slots());
+    let kept = kept_mask(cdt, search, carved);
     let n_input = search.input.len();
     cdt.dt
         .mesh
@@ -626,6 +576,44 @@ fn ring_verts(f: &super::prepare::MergedFacet) -> Vec<u32> {
     verts.sort_unstable();
     verts.dedup();
     verts
+}
+
+/// The two coordinate axes a plane with normal `n` is seen along its normal in (those
+/// other than `n`'s largest component).
+fn projection_axes(n: &Point) -> (usize, usize) {
+    let ax = (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(2);
+    ((ax + 1) % 3, (ax + 2) % 3)
+}
+
+/// Whether point `w`, seen along axes `(i, j)`, lies inside the ring of input points
+/// `ring` (even-odd rule).
+fn inside_ring(input: &[Point], ring: &[u32], (i, j): (usize, usize), w: &Point) -> bool {
+    let mut odd = false;
+    for (k, &x) in ring.iter().enumerate() {
+        let a = input[x as usize];
+        let b = input[ring[(k + 1) % ring.len()] as usize];
+        if (a[j] > w[j]) != (b[j] > w[j])
+            && w[i] < a[i] + (w[j] - a[j]) * (b[i] - a[i]) / (b[j] - a[j])
+        {
+            odd = !odd;
+        }
+    }
+    odd
+}
+
+/// The points of triangle `q` the referee samples for coverage: its centroid, and the
+/// points halfway from it to each corner.
+fn face_samples(q: &[Point; 3]) -> [Point; 4] {
+    let third = 1.0 / 3.0;
+    [
+        [third, third, third],
+        [0.5, 0.25, 0.25],
+        [0.25, 0.5, 0.25],
+        [0.25, 0.25, 0.5],
+    ]
+    .map(|w| std::array::from_fn(|c| w[0] * q[0][c] + w[1] * q[1][c] + w[2] * q[2][c]))
 }
 
 /// Facet `fi`'s slab (`diag` the input's diagonal), or `None` for a facet without
