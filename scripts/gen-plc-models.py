@@ -21,7 +21,12 @@ It writes two kinds of files:
       internal facets (two regions);
    d. gridbox_*.smesh: boxes whose faces are split into grids of coplanar quads;
    e. box_internal_facet.poly (two regions with attributes), box_cavity.poly (a cavity
-      carved by a hole point), ushape.poly (non-convex; its hull is a box, for -c).
+      carved by a hole point), ushape.poly (non-convex; its hull is a box, for -c);
+   f. window_wall.poly, windows.poly: walls with windows (hole polygons with hole points)
+      that other facets fill, with markers of their own or the wall's;
+   g. degenerate_tris.off, degenerate_tris_{obj,ply,ascii,binary}.*: one closed
+      surface whose files add triangles with a repeated corner (a literal repeat, and two
+      corners at one point after welding), which the readers drop.
 2. Copies of small corpus models (unmodified), with data/plc/LICENSES.md built from the
    corpus MANIFEST.tsv. Skipped, keeping the copies already present, when the corpus is
    not found ($CORPUS, --corpus DIR, or ../shared/corpus relative to the repository).
@@ -31,6 +36,7 @@ import math
 import os
 import random
 import shutil
+import struct
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -383,6 +389,117 @@ def ushape():
     write_poly("ushape.poly", comment, pts, facets)
 
 
+# ---------- f. windows: facets with holes filled by other facets ----------
+
+def window_wall():
+    pts = []
+    v = add_box(pts, (0, 0, 0), (4, 2, 3))
+    win = [len(pts) + k for k in range(4)]
+    pts += [(1, 0, 1), (3, 0, 1), (3, 0, 2), (1, 0, 2)]
+    facets = [f for k, f in enumerate(box_facets(v, 1)) if k != 2]
+    wall = [v[0][0][0], v[1][0][0], v[1][0][1], v[0][0][1]]
+    facets.append(([wall, win], [(2, 0, 1.5)], 1))
+    facets.append(single(win, 5))
+    comment = ("Box [0,4]x[0,2]x[0,3] whose wall y = 0 (marker 1) has a window [1,3]x[1,2] (a hole polygon with\n"
+               "a hole point) filled by a facet of its own, marker 5: the window's two triangles carry 5.")
+    write_poly("window_wall.poly", comment, pts, facets, first=1)
+
+
+def windows():
+    pts = []
+    def add(*ps):
+        out = []
+        for q in ps:
+            out.append(len(pts))
+            pts.append(q)
+        return out
+    c = add((0, 0, 0), (6, 0, 0), (6, 4, 0), (0, 4, 0), (0, 0, 3), (6, 0, 3), (6, 4, 3), (0, 4, 3))
+    mid = add((3, 4, 0), (3, 4, 3))
+    a = add((1, 0, 1), (2, 0, 1), (2, 0, 2), (1, 0, 2))
+    b = add((3.5, 0, 0.5), (5, 0, 0.5), (5, 0, 2.5), (3.5, 0, 2.5))
+    e = add((6, 1, 1), (6, 3, 1), (6, 3, 2), (6, 1, 2))
+    l = add((1, 4, 1), (1, 4, 2), (2, 4, 2), (2, 4, 1))
+    r = add((4, 4, 1), (4, 4, 2), (5, 4, 2), (5, 4, 1))
+    facets = [
+        single([c[0], c[3], mid[0], c[2], c[1]], 1),  # z = 0
+        single([c[4], c[5], c[6], mid[1], c[7]], 1),  # z = 3
+        single([c[0], c[4], c[7], c[3]], 1),  # x = 0
+        # y = 0: two windows, one filled by a quad (marker 5), one by two triangles (6)
+        ([[c[0], c[1], c[5], c[4]], a, b], [(1.5, 0, 1.5), (4.25, 0, 1.5)], 1),
+        single(a, 5),
+        ([[b[0], b[1], b[2]], [b[0], b[2], b[3]]], [], 6),
+        # x = 6: one window (marker 7)
+        ([[c[1], c[2], c[6], c[5]], e], [(6, 2, 1.5)], 1),
+        single(e, 7),
+        # y = 4: two coplanar quads of one marker, merged; the left one's window is filled
+        # by a facet of the same marker (it merges too), the right one's by marker 8
+        ([[c[3], c[7], mid[1], mid[0]], l], [(1.5, 4, 1.5)], 1),
+        single(l, 1),
+        ([[mid[0], mid[1], c[6], c[2]], r], [(4.5, 4, 1.5)], 1),
+        single(r, 8),
+    ]
+    comment = ("Box [0,6]x[0,4]x[0,3] with windows: two in the wall y = 0 (filled by a quad of marker 5 and by\n"
+               "two triangles of marker 6), one in the wall x = 6 (marker 7), and one in each of the two\n"
+               "coplanar quads of the wall y = 4, which merge: the left window is filled by a facet of the\n"
+               "wall's own marker 1, the right one by marker 8.")
+    write_poly("windows.poly", comment, pts, facets)
+
+
+# ---------- g. surface meshes with triangles that have a repeated corner ----------
+
+def degenerate_tris():
+    # A pentagonal bipyramid with irregular coordinates, and a copy of vertex 2 (index 7).
+    pts = [(0.05, -0.1, 1.3), (1.0, 0.0, 0.02), (0.3, 0.95, -0.03), (-0.8, 0.6, 0.01),
+           (-0.75, -0.6, 0.0), (0.35, -0.9, -0.02), (-0.02, 0.07, -1.1), (0.3, 0.95, -0.03)]
+    ring = [1, 2, 3, 4, 5]
+    tris = []
+    for k in range(5):
+        a, b = ring[k], ring[(k + 1) % 5]
+        tris.append((0, a, b))
+        tris.append((6, b, a))
+    # The upper triangle over 2-3 uses the copy of vertex 2: welding makes it whole again.
+    tris[2] = (0, 7, 3)
+    # Triangles with a repeated corner: two corners at one point after welding (2 and its
+    # copy 7), and a literal repeat.
+    degenerate = [(2, 7, 3), (4, 4, 5)]
+    allt = tris[:5] + [degenerate[0]] + tris[5:] + [degenerate[1]]
+    comment = ("Pentagonal bipyramid (10 triangles) with two more triangles that have a repeated corner:\n"
+               "(2, 7, 3), where point 7 is a copy of point 2, and (4, 4, 5). Both are dropped on reading.")
+    head = [f"# {l}" for l in comment.splitlines()] + ["# Written by scripts/gen-plc-models.py; do not edit."]
+    with open(os.path.join(OUT, "degenerate_tris.off"), "w") as f:
+        f.write("OFF\n" + "\n".join(head) + f"\n{len(pts)} {len(allt)} 0\n")
+        f.writelines(f"{fmt(x)} {fmt(y)} {fmt(z)}\n" for x, y, z in pts)
+        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in allt)
+    with open(os.path.join(OUT, "degenerate_tris_obj.obj"), "w") as f:
+        f.write("\n".join(head) + "\n")
+        f.writelines(f"v {fmt(x)} {fmt(y)} {fmt(z)}\n" for x, y, z in pts)
+        f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in allt)
+    with open(os.path.join(OUT, "degenerate_tris_ply.ply"), "w") as f:
+        f.write("ply\nformat ascii 1.0\n" + "".join(f"comment {l[2:]}\n" for l in head) +
+                f"element vertex {len(pts)}\nproperty double x\nproperty double y\nproperty double z\n"
+                f"element face {len(allt)}\nproperty list uchar int vertex_indices\nend_header\n")
+        f.writelines(f"{fmt(x)} {fmt(y)} {fmt(z)}\n" for x, y, z in pts)
+        f.writelines(f"3 {a} {b} {c}\n" for a, b, c in allt)
+    # STL has no indices: the repeated corner is two equal corners. Coordinates are
+    # written as floats in the binary file, so both STL files use float32 values.
+    f32 = [tuple(struct.unpack("<f", struct.pack("<f", c))[0] for c in p) for p in pts]
+    with open(os.path.join(OUT, "degenerate_tris_ascii.stl"), "w") as f:
+        f.write("solid degenerate\n")
+        for t in allt:
+            f.write("  facet normal 0 0 0\n    outer loop\n")
+            f.writelines(f"      vertex {fmt(f32[v][0])} {fmt(f32[v][1])} {fmt(f32[v][2])}\n" for v in t)
+            f.write("    endloop\n  endfacet\n")
+        f.write("endsolid degenerate\n")
+    with open(os.path.join(OUT, "degenerate_tris_binary.stl"), "wb") as f:
+        f.write(b"binary STL with two triangles that have a repeated corner".ljust(80, b" "))
+        f.write(struct.pack("<I", len(allt)))
+        for t in allt:
+            f.write(struct.pack("<3f", 0, 0, 0))
+            for v in t:
+                f.write(struct.pack("<3f", *pts[v]))
+            f.write(b"\0\0")
+
+
 # ---------- copies of corpus models ----------
 
 def find_corpus(argv):
@@ -430,7 +547,7 @@ def copy_corpus(corpus):
             "## Hand-made models",
             "",
             "Every other model file in this directory (`prism_*`, `fig4_*`, `cosph_*`, `gridbox_*`, `box_*`, "
-            "`ushape.poly`) is written by `scripts/gen-plc-models.py` and is part of this project, under its "
+            "`ushape.poly`, `window*.poly`, `degenerate_tris*`) is written by `scripts/gen-plc-models.py` and is part of this project, under its "
             "license (MIT OR Apache-2.0).",
             "",
             "## Reference meshes",
@@ -458,6 +575,9 @@ def main(argv):
     box_internal_facet()
     box_cavity()
     ushape()
+    window_wall()
+    windows()
+    degenerate_tris()
     corpus = find_corpus(argv)
     if corpus:
         copy_corpus(corpus)

@@ -126,6 +126,18 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
     let (checked, precheck_secs) = checked;
     let mut warnings = checked?;
     let done = done?;
+    // Exit 0 means a valid CDT: the mesh is certified from its nodes and tets alone
+    // before anyone gets it.
+    let t_certify = Instant::now();
+    let view = crate::check::MeshView {
+        points: &done.mesh.points,
+        tets: &done.mesh.tets,
+        first_index: done.mesh.first_index,
+    };
+    let copts = crate::check::CertifyOptions::of(opts);
+    crate::check::certify_prepared(plc, Some(&done.prepared), view, &copts)
+        .map_err(MeshError::NotCertified)?;
+    let certify_secs = t_certify.elapsed().as_secs_f64();
     warnings.extend(done.warnings);
     let ps = done.stats;
     let stats = Stats {
@@ -134,6 +146,7 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
         output_tets: ps.output_tets,
         delaunay_secs: ps.delaunay_secs,
         precheck_secs,
+        certify_secs,
         total_secs: start.elapsed().as_secs_f64(),
         plc: Some(ps),
         ..Default::default()

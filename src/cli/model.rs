@@ -137,6 +137,10 @@ pub fn run_model(
     bar.stage(Stage::Read);
     say!(say, "Opening {}.", file.display());
     let plc = tetcdt::io::read_plc(file).map_err(tetcdt::Error::from)?;
+    // What reading found (dropped degenerate triangles) matters even if meshing fails.
+    for w in &plc.warnings {
+        say.warn(w);
+    }
 
     if opts.detect_intersections {
         wopts.comment = Some(comment);
@@ -226,7 +230,8 @@ pub fn run_model(
         bar.message("check");
         say!(say, "");
         say!(say, "Checking the mesh...");
-        if let Err(problems) = tetcdt::check::check_mesh(&plc, &meshed.mesh) {
+        let copts = tetcdt::check::CertifyOptions::of(opts);
+        if let Err(problems) = tetcdt::check::check_mesh(&plc, &meshed.mesh, &copts) {
             return Err(check_failure(&problems));
         }
         say!(say, "Mesh check passed.");
@@ -273,6 +278,7 @@ fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed, mesh_points: usize) 
     say!(say, "");
     say!(say, "  Sorting seconds: {}", s.sort_secs);
     say!(say, "  Check seconds: {}", s.precheck_secs);
+    say!(say, "  Certify seconds: {}", s.certify_secs);
     say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
     say!(say, "  Meshing seconds: {}", s.total_secs);
     let rows = s.table1_rows();

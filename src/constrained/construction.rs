@@ -10,7 +10,6 @@ use super::in_place::{
     for_each_facet_segment, insert_free_unrecovering, insert_unrecovered, midpoint_parameter,
     split_encroached, FreeInPlace, Segs, MAX_IN_PLACE, MAX_IN_PLACE_EACH,
 };
-use super::prepare::PreparedPlc;
 use super::{
     debug, free, max_facet_points, restart_work_bound, segments, slivers, FacetContext, FacetPoint,
     FacetTris, PlcOptions, PlcStats, SegmentSplit, FREE_POINT, RESTART_WORK,
@@ -20,6 +19,7 @@ use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
 use crate::geom::Point;
 use crate::mesh::{VertexId, VertexLists};
+use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
 use rustc_hash::{FxHashMap, FxHashSet};

@@ -7,7 +7,7 @@
 //! The answer is only "certainly empty" or "maybe not"; the second case is decided by
 //! meshing and carving.
 
-use super::prepare::PreparedPlc;
+use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
 use rustc_hash::FxHashMap;
 
@@ -99,14 +99,14 @@ pub fn open_boundary(plc: &Plc, prep: &PreparedPlc) -> Option<Vec<[u32; 2]>> {
 }
 
 /// Facets that take part: those with at least one ring.
-fn f_alive(f: &super::prepare::MergedFacet) -> bool {
+fn f_alive(f: &crate::plc::prepare::MergedFacet) -> bool {
     !f.rings.is_empty()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constrained::prepare::prepare;
+    use crate::plc::prepare::prepare;
     use crate::plc::Facet;
 
     fn cube(drop_top: bool, inner_polygon: bool) -> Plc {

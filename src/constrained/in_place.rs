@@ -4,11 +4,11 @@
 //! the caller.
 
 use super::cdt::{edge_key, face_key, Cdt};
-use super::prepare::PreparedPlc;
 use super::{debug, for_each_edge, free, segments, SegmentSplit};
 use crate::error::MeshError;
 use crate::geom::Point;
 use crate::mesh::VertexId;
+use crate::plc::prepare::PreparedPlc;
 use rustc_hash::FxHashMap;
 
 /// Inserts point `p` (perturbation index `pert`), on facet `fi`, into the CDT with the

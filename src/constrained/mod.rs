@@ -18,7 +18,6 @@ pub mod flip;
 mod flip_queue;
 mod free;
 mod in_place;
-pub mod prepare;
 pub mod segments;
 mod slivers;
 
@@ -28,12 +27,12 @@ use crate::error::{Error, MeshError};
 use crate::geom::Point;
 use crate::mesh::VertexId;
 use crate::output::MeshOut;
+use crate::plc::prepare::{self, prepare, PreparedPlc};
 use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
 use cavity::{insert_region, Outcome};
 use cdt::{edge_key, Cdt};
 use construction::{attempt, Attempt, Built};
-use prepare::{prepare, PreparedPlc};
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -199,6 +198,9 @@ pub struct PlcMesh {
     pub stats: PlcStats,
     /// Warnings.
     pub warnings: Vec<String>,
+    /// The PLC as prepared for meshing (merged facets, segments), which the certifier
+    /// judges the mesh against.
+    pub prepared: PreparedPlc,
 }
 
 /// Whether to trace restarts, Steiner points, cavity widening and flip fallbacks on
@@ -504,6 +506,7 @@ pub fn mesh_plc_with_progress(
         mesh,
         stats,
         warnings,
+        prepared: base,
     })
 }
 

@@ -7,13 +7,14 @@
 //! the domain, removes the tet from the CDT instead.
 
 use super::cdt::Cdt;
-use super::prepare::{newell_normal, PreparedPlc};
 use crate::carve::{carve, containing_tet_near, Carved};
+use crate::geom::bvh::{Aabb, Bvh};
+use crate::geom::polygon::newell_normal;
 use crate::geom::predicates::{insphere, orient3d};
 use crate::geom::{cross, diagonal, dot, longest_edge2, norm, sub, Point};
 use crate::mesh::VertexId;
+use crate::plc::prepare::PreparedPlc;
 use crate::plc::Region;
-use crate::precheck::bvh::{Aabb, Bvh};
 use std::cell::OnceCell;
 
 /// A tet is flat when its volume is at most this fraction of its longest edge cubed: the
@@ -571,7 +572,7 @@ fn retry_points(cdt: &mut Cdt, search: &Search<'_>, found: &Found) -> Vec<Point>
 }
 
 /// The sorted vertices of a merged facet's rings.
-fn ring_verts(f: &super::prepare::MergedFacet) -> Vec<u32> {
+fn ring_verts(f: &crate::plc::prepare::MergedFacet) -> Vec<u32> {
     let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
     verts.sort_unstable();
     verts.dedup();
@@ -863,7 +864,7 @@ mod tests {
             ],
             ..Default::default()
         };
-        let prep = super::super::prepare::prepare(&plc, true).unwrap();
+        let prep = crate::plc::prepare::prepare(&plc, true).unwrap();
         let search = Search {
             prep: &prep,
             input: &plc.points,
@@ -919,7 +920,7 @@ mod tests {
             ],
             ..Default::default()
         };
-        let prep = super::super::prepare::prepare(&plc, true).unwrap();
+        let prep = crate::plc::prepare::prepare(&plc, true).unwrap();
         let search = Search {
             prep: &prep,
             input: &plc.points,

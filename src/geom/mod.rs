@@ -1,9 +1,11 @@
 //! Geometry: exact predicates with symbolic perturbation, and the Hilbert/BRIO ordering.
 
+pub mod bvh;
 pub mod expansion;
 pub mod fixed;
 pub mod hilbert;
 pub mod lifted;
+pub mod polygon;
 pub mod predicates;
 
 pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign, StaticFilter};

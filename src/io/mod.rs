@@ -1,5 +1,6 @@
 //! Readers of TetGen's input formats and writers of its output files.
 
+pub mod ele;
 pub mod medit;
 pub mod node;
 pub mod obj;
@@ -24,15 +25,23 @@ pub fn read_plc(path: &Path) -> Result<Plc, InputError> {
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
+    // Surface meshes (triangle soups from CAD and scanning tools) often hold triangles
+    // that exact welding collapses; those add nothing to the surface and are dropped.
+    let surface = |plc: Result<Plc, InputError>| {
+        plc.map(|mut p| {
+            crate::precheck::drop_degenerate_polygons(&mut p);
+            p
+        })
+    };
     match ext.as_str() {
         "node" => node::read(path),
         "poly" => poly::read(path),
         "smesh" => smesh::read(path),
-        "off" => off::read(path),
-        "obj" => obj::read(path),
-        "stl" => stl::read(path),
-        "ply" => ply::read(path),
-        "mesh" => medit::read(path),
+        "off" => surface(off::read(path)),
+        "obj" => surface(obj::read(path)),
+        "stl" => surface(stl::read(path)),
+        "ply" => surface(ply::read(path)),
+        "mesh" => surface(medit::read(path)),
         "meshb" => Err(InputError::Invalid {
             file: path.to_path_buf(),
             msg: "binary Medit files (.meshb) are not supported; convert to ASCII .mesh".into(),

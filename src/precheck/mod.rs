@@ -10,14 +10,13 @@
 //! does). An open surface is refused only once carving shows that nothing would remain
 //! ([`empty_domain_message`]), since open facets inside a closed one, or `-c`, are fine.
 
-pub mod bvh;
 pub mod detect;
 pub mod surface;
 pub mod tritri;
 
 use crate::error::InputError;
+use crate::geom::bvh::{Aabb, Bvh};
 use crate::plc::Plc;
-use bvh::{Aabb, Bvh};
 use rustc_hash::FxHashMap;
 use surface::clean_ring;
 pub use tritri::Contact;
@@ -281,7 +280,7 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
     for (fi, f) in plc.facets.iter().enumerate() {
         for (pi, poly) in f.polygons.iter().enumerate() {
             let ring = clean_ring(poly, &rep);
-            if ring.len() >= 3 && crate::constrained::prepare::all_collinear(&plc.points, &ring) {
+            if ring.len() >= 3 && crate::geom::polygon::all_collinear(&plc.points, &ring) {
                 return Err(invalid(
                     plc,
                     format!(
@@ -335,7 +334,7 @@ fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
     if ring.len() < 4 {
         return None;
     }
-    let n = crate::constrained::prepare::newell_normal(points, ring);
+    let n = crate::geom::polygon::newell_normal(points, ring);
     let len = n.iter().map(|x| x * x).sum::<f64>().sqrt();
     if len == 0.0 || !len.is_finite() {
         return None;
@@ -361,8 +360,79 @@ fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
     (far.1 > MAX_UNFLATNESS * size).then_some((far.0, far.1, size))
 }
 
-/// Duplicate polygons: the same set of (representative) vertices.
+/// The polygons (facet, polygon) that bound a hole of their own facet: for each hole
+/// point, the smallest ring of its facet around it. Such a polygon covers no area, so
+/// another facet may fill it (a window in a wall, with a marker of its own).
+fn hole_rings(plc: &Plc, rep: &[u32]) -> rustc_hash::FxHashSet<(usize, usize)> {
+    use crate::geom::polygon::{newell_normal, Projection, RingSide};
+    let mut out = rustc_hash::FxHashSet::default();
+    for (fi, f) in plc.facets.iter().enumerate() {
+        if f.holes.is_empty() {
+            continue;
+        }
+        let rings: Vec<(usize, Vec<u32>)> = f
+            .polygons
+            .iter()
+            .enumerate()
+            .map(|(pi, p)| (pi, clean_ring(p, rep)))
+            .filter(|(_, r)| r.len() >= 3)
+            .collect();
+        for h in &f.holes {
+            let around = rings.iter().filter_map(|(pi, r)| {
+                let n = newell_normal(&plc.points, r);
+                let proj = Projection::along(&n);
+                let inside = proj.locate_in_ring(&plc.points, r, h) == RingSide::Inside;
+                let area = crate::geom::norm(&n);
+                inside.then_some((area, *pi))
+            });
+            if let Some((_, pi)) = around.min_by(|a, b| a.0.total_cmp(&b.0)) {
+                out.insert((fi, pi));
+            }
+        }
+    }
+    out
+}
+
+/// Drops the polygons of a surface mesh that have fewer than three distinct corners once
+/// exactly equal points are welded (two corners at one point): they add nothing to the
+/// surface. One warning counts them and names the first few. Polygons with an index out
+/// of range are left for [`check_elements`] to report.
+pub fn drop_degenerate_polygons(plc: &mut Plc) {
+    let rep = representatives(&plc.points);
+    let n = plc.points.len();
+    let mut dropped: Vec<usize> = Vec::new();
+    for (fi, f) in plc.facets.iter_mut().enumerate() {
+        let before = f.polygons.len();
+        f.polygons.retain(|poly| {
+            poly.len() < 3
+                || poly.iter().any(|&v| v as usize >= n)
+                || clean_ring(poly, &rep).len() >= 3
+        });
+        if f.polygons.len() < before {
+            dropped.push(fi);
+        }
+    }
+    if dropped.is_empty() {
+        return;
+    }
+    let list: Vec<String> = dropped
+        .iter()
+        .take(SHOWN)
+        .map(|&fi| facet_name(plc, fi))
+        .collect();
+    plc.warnings.push(format!(
+        "{} facet(s) with a repeated corner (two corners at the same point) add nothing to \
+         the surface and were dropped: {}{}",
+        dropped.len(),
+        list.join(", "),
+        more(dropped.len())
+    ));
+}
+
+/// Duplicate polygons: the same set of (representative) vertices, both covering area (a
+/// polygon that bounds a hole of its own facet and is also a facet is a filled window).
 pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
+    let holes = hole_rings(plc, rep);
     // Triangles (most polygons) are keyed without allocating; a triangle can only
     // duplicate a triangle.
     let mut triangles: FxHashMap<[u32; 3], (usize, usize)> = FxHashMap::default();
@@ -370,6 +440,9 @@ pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
     let mut dups: Vec<((usize, usize), (usize, usize))> = Vec::new();
     for (fi, f) in plc.facets.iter().enumerate() {
         for (pi, poly) in f.polygons.iter().enumerate() {
+            if holes.contains(&(fi, pi)) {
+                continue;
+            }
             let first = if let [a, b, c] = poly[..] {
                 let mut key = [a, b, c].map(|v| rep.get(v as usize).copied().unwrap_or(v));
                 if key[0] == key[1] || key[1] == key[2] || key[0] == key[2] {

@@ -3,7 +3,7 @@
 //! facet's triangles cover exactly its polygons minus its holes.
 
 use crate::constrained::facet2d::triangulate_facet;
-use crate::constrained::prepare::newell_normal;
+use crate::geom::polygon::newell_normal;
 use crate::plc::Plc;
 
 /// One triangle of an input facet, with representative vertex ids.

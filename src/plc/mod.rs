@@ -1,4 +1,7 @@
-//! The piecewise linear complex (PLC) model that every reader produces.
+//! The piecewise linear complex (PLC) model that every reader produces, and its
+//! preparation for meshing and certifying ([`prepare`]: merged facets and segments).
+
+pub mod prepare;
 
 use std::path::PathBuf;
 
@@ -49,6 +52,9 @@ pub struct Plc {
     pub first_index: usize,
     /// The file the model was read from (the `.node` file for a `.poly` with an empty node section is not recorded here).
     pub source: PathBuf,
+    /// Warnings from reading it (such as the degenerate triangles of a surface mesh that
+    /// were dropped), for the caller to show.
+    pub warnings: Vec<String>,
 }
 
 impl Plc {

@@ -15,6 +15,8 @@
 
 use crate::error::InputError;
 use crate::geom::norm;
+pub(crate) use crate::geom::polygon::{all_collinear, dedup_ring, newell_normal};
+use crate::geom::polygon::{Projection, RingSide};
 use crate::plc::Plc;
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -64,50 +66,6 @@ pub struct MergedFacet {
 struct Poly {
     verts: Vec<u32>,
     facet: usize,
-}
-
-/// Drops repeated consecutive vertices, also across the wrap.
-pub(crate) fn dedup_ring(poly: &[u32]) -> Vec<u32> {
-    let mut out: Vec<u32> = Vec::with_capacity(poly.len());
-    for &v in poly {
-        if out.last() != Some(&v) {
-            out.push(v);
-        }
-    }
-    while out.len() > 1 && out[0] == out[out.len() - 1] {
-        out.pop();
-    }
-    out
-}
-
-/// Newell's normal of a polygon (not normalized), summed like the validator does.
-pub fn newell_normal(points: &[[f64; 3]], ring: &[u32]) -> [f64; 3] {
-    let mut n = [0.0f64; 3];
-    for i in 0..ring.len() {
-        let a = points[ring[i] as usize];
-        let b = points[ring[(i + 1) % ring.len()] as usize];
-        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
-    n
-}
-
-/// Exact test: are all vertices of the ring on one line? (All three axis projections
-/// have zero orientation for every vertex against the first two distinct ones.)
-pub(crate) fn all_collinear(points: &[[f64; 3]], ring: &[u32]) -> bool {
-    let p0 = points[ring[0] as usize];
-    let Some(p1) = ring.iter().map(|&v| points[v as usize]).find(|p| *p != p0) else {
-        return true;
-    };
-    ring.iter().all(|&v| {
-        let q = points[v as usize];
-        (0..3).all(|k| {
-            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-            let c = |p: [f64; 3]| robust::Coord { x: p[i], y: p[j] };
-            robust::orient2d(c(p0), c(p1), c(q)) == 0.0
-        })
-    })
 }
 
 /// Union-find with path halving.
@@ -263,6 +221,12 @@ pub fn prepare_except(
             if apart(a) || apart(b) {
                 continue;
             }
+            // Facets with different markers stay apart, as in TetGen: their common edges
+            // stay segments, and each keeps its marker.
+            let marker = |i: usize| plc.facets[polys[i].facet].marker;
+            if marker(a) != marker(b) {
+                continue;
+            }
             if let (Some(n1), Some(n2)) = (unit[a], unit[b]) {
                 let d = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2];
                 if d.abs() >= cos_tol {
@@ -335,9 +299,7 @@ pub fn prepare_except(
         }
         mf.source_facets.sort_unstable();
         mf.marker = plc.facets[mf.source_facets[0]].marker;
-        for &fi in &mf.source_facets {
-            mf.holes.extend_from_slice(&plc.facets[fi].holes);
-        }
+        mf.holes = open_holes(plc, &polys, g, mf.normal);
         facets.push(mf);
     }
     facets.sort_by_key(|f| f.source_facets[0]);
@@ -360,6 +322,31 @@ pub fn prepare_except(
         facets,
         loose_points,
     })
+}
+
+/// The hole points of the merged group `group` (polygon indices into `polys`, normal
+/// `normal`) that stay holes: a hole point of one input facet that lies inside a polygon
+/// of another facet of the group marks a window that the other facet fills (a wall with
+/// a window given its own facet), so it removes nothing from the merged facet.
+fn open_holes(plc: &Plc, polys: &[Poly], group: &[usize], normal: [f64; 3]) -> Vec<[f64; 3]> {
+    let mut sources: Vec<usize> = group.iter().map(|&i| polys[i].facet).collect();
+    sources.sort_unstable();
+    sources.dedup();
+    let proj = Projection::along(&normal);
+    let mut holes = Vec::new();
+    for &fi in &sources {
+        for h in &plc.facets[fi].holes {
+            let filled = group.iter().any(|&i| {
+                polys[i].facet != fi
+                    && polys[i].verts.len() >= 3
+                    && proj.locate_in_ring(&plc.points, &polys[i].verts, h) == RingSide::Inside
+            });
+            if !filled {
+                holes.push(*h);
+            }
+        }
+    }
+    holes
 }
 
 #[cfg(test)]
@@ -445,10 +432,22 @@ mod tests {
             facets: faces
                 .into_iter()
                 .enumerate()
-                .map(|(i, f)| facet(f, i as i32 + 1))
+                // The two top quads share marker 2.
+                .map(|(i, f)| facet(f, if i == 2 { 2 } else { i as i32 + 1 }))
                 .collect(),
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn coplanar_neighbours_with_different_markers_stay_apart() {
+        let mut plc = split_top_cube();
+        plc.facets[2].marker = 7;
+        let p = prepare(&plc, true).unwrap();
+        assert_eq!(p.facets.len(), 7);
+        assert!(p.segments.contains(&[8, 9]));
+        assert_eq!(p.facets[1].marker, 2);
+        assert_eq!(p.facets[2].marker, 7);
     }
 
     #[test]
@@ -515,7 +514,7 @@ mod tests {
         ];
         Plc {
             points: pts,
-            facets: vec![facet(vec![vec![0, 1, 2]], 5), facet(vec![vec![1, 0, 3]], 6)],
+            facets: vec![facet(vec![vec![0, 1, 2]], 5), facet(vec![vec![1, 0, 3]], 5)],
             ..Default::default()
         }
     }
