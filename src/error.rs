@@ -78,6 +78,10 @@ pub enum MeshError {
     /// An internal consistency check failed; this is a bug.
     #[error("internal error: {0}")]
     Internal(String),
+    /// The finished mesh failed the certifier: it is not a CDT of the PLC, so no mesh is
+    /// given (a bug, or a PLC the mesher does not handle).
+    #[error("the mesh made is not a valid CDT of the PLC, so none is written: {}", .0.report())]
+    NotCertified(crate::check::CheckFailure),
     /// A construction passed its bound on work ([`crate::constrained::cdt::Cdt::work_limit`]):
     /// the restarts end as if it had finished over the bound.
     #[error("the construction passed its bound on work")]

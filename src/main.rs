@@ -60,6 +60,10 @@ named <base>.<n>.node gives <base>.<n+1>.*. Files are written atomically. The no
 are the input points in input order, without those no tet uses (unless -J), then the
 Steiner points.
 
+--certify PREFIX FILE certifies an existing mesh (PREFIX.node, PREFIX.ele, from any
+mesher) as a CDT of FILE (with -c: its convex hull kept; with -M: facets not merged)
+and exits 1 listing the problems if it is not one.
+
 Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,
 3 invalid input, 4 I/O error. With several FILEs: the code of the first FILE (in
 command-line order) that failed; the others are meshed all the same.";
@@ -81,6 +85,10 @@ struct Cli {
     /// Validate the mesh after writing it; exit 1 listing the problems if any.
     #[arg(long)]
     check: bool,
+    /// Certify the mesh PREFIX.node/PREFIX.ele as a CDT of FILE (any mesher's); exit 1
+    /// listing the problems if it is not one. Nothing is meshed.
+    #[arg(long, value_name = "PREFIX")]
+    certify: Option<PathBuf>,
     /// Write the run's statistics (with -p, the paper's Table 1 figures) as JSON to FILE
     /// (one line per model).
     #[arg(long = "stats-json", value_name = "FILE")]
@@ -184,6 +192,20 @@ fn parse_args(args: &[OsString]) -> Result<Option<cli::Invocation>, Failure> {
     opts.output = cli.output;
     opts.check = cli.check;
     opts.stats_json = cli.stats_json;
+    if cli.certify.is_some() {
+        let meshing = opts.check
+            || opts.stats_json.is_some()
+            || opts.output.is_some()
+            || cli.summary.is_some()
+            || cli.jobs.is_some()
+            || opts.detect_intersections;
+        if cli.files.len() != 1 || meshing {
+            return Err(Failure::new(
+                EXIT_USAGE,
+                anyhow!("--certify PREFIX takes one input FILE and no meshing options (-o, -d, --check, --stats-json, --summary, --jobs)"),
+            ));
+        }
+    }
     if opts.detect_intersections && (opts.check || opts.stats_json.is_some()) {
         return Err(Failure::new(
             EXIT_USAGE,
@@ -196,6 +218,7 @@ fn parse_args(args: &[OsString]) -> Result<Option<cli::Invocation>, Failure> {
         jobs: cli.jobs.map(|n| n as usize),
         summary: cli.summary,
         switches,
+        certify: cli.certify,
     }))
 }
 

@@ -17,6 +17,8 @@ pub struct Stats {
     pub delaunay_secs: f64,
     /// Seconds of the checks before meshing (`-p`: the intersection test above all).
     pub precheck_secs: f64,
+    /// Seconds of the certification of the finished mesh (`-p`).
+    pub certify_secs: f64,
     /// Seconds of the whole meshing call.
     pub total_secs: f64,
     /// The figures of PLC meshing (`-p`), the rows of the paper's Table 1.
@@ -169,6 +171,7 @@ impl Stats {
             ("duplicate_points".into(), self.duplicate_points.to_string()),
             ("output_tets".into(), self.output_tets.to_string()),
             ("delaunay_secs".into(), json_f64(self.delaunay_secs)),
+            ("certify_secs".into(), json_f64(self.certify_secs)),
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
         if let Some(p) = &self.plc {

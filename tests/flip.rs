@@ -51,7 +51,9 @@ fn mesh(path: &Path, sw: &str) -> Meshed {
     let opts = Options::from_switches([sw]).unwrap();
     let m = tetcdt::tetrahedralize(&plc, &opts)
         .unwrap_or_else(|e| panic!("{} {sw}: {e}", path.display()));
-    if let Err(problems) = tetcdt::check::check_mesh(&plc, &m.mesh) {
+    if let Err(problems) =
+        tetcdt::check::check_mesh(&plc, &m.mesh, &tetcdt::check::CertifyOptions::of(&opts))
+    {
         panic!("{} {sw}: check failed: {problems:?}", path.display());
     }
     m
@@ -299,6 +301,15 @@ fn validator() -> Option<PathBuf> {
     ok.then_some(v)
 }
 
+/// Whether the shared referee reads the format of `p` (it does not read STL, PLY or OBJ;
+/// the certifier, which every run goes through, judges those).
+fn referee_reads(p: &Path) -> bool {
+    matches!(
+        p.extension().and_then(|e| e.to_str()),
+        Some("off" | "poly" | "smesh" | "mesh" | "node")
+    )
+}
+
 #[test]
 fn flip_meshes_pass_the_referee() {
     let Some(referee) = validator() else {
@@ -310,7 +321,7 @@ fn flip_meshes_pass_the_referee() {
     models.push(root().join("data/flip/prism_stuck.poly"));
     models.push(root().join("data/flip/bent_9gon_60.poly"));
     models.push(root().join("data/flip/bent_17gon_150.poly"));
-    for path in models {
+    for path in models.into_iter().filter(|p| referee_reads(p)) {
         let hull = path.starts_with(root().join("data/flip"));
         let prefix = dir.path().join("out");
         let sw = if hull { "-pcQF" } else { "-pQF" };

@@ -422,7 +422,7 @@ fn perturbed_cubes_mesh_and_open_ones_are_refused() {
             })?;
             match (drop, r) {
                 (None, Ok(m)) => {
-                    if let Err(p) = tetcdt::check::check_mesh(&plc, &m.mesh) {
+                    if let Err(p) = tetcdt::check::check_mesh(&plc, &m.mesh, &Default::default()) {
                         return Err(TestCaseError::fail(format!("invalid mesh {p:?} of {what}")));
                     }
                 }
@@ -516,7 +516,7 @@ fn two_boxes_are_refused_exactly_when_they_intersect() {
                 Ok(m) => {
                     m2.fetch_add(1, Relaxed);
                     prop_assert!(!crossing, "meshed crossing boxes: {}", what);
-                    if let Err(p) = tetcdt::check::check_mesh(&plc, &m.mesh) {
+                    if let Err(p) = tetcdt::check::check_mesh(&plc, &m.mesh, &Default::default()) {
                         return Err(TestCaseError::fail(format!("invalid mesh {p:?} of {what}")));
                     }
                 }

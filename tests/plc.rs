@@ -225,6 +225,15 @@ fn validator() -> Option<PathBuf> {
 
 /// Runs `f` on every item on two threads (the machine's cores are shared); returns the
 /// failure messages, in the items' order.
+/// Whether the shared referee reads the format of `p` (it does not read STL, PLY or OBJ;
+/// the certifier, which every run goes through, judges those).
+fn referee_reads(p: &Path) -> bool {
+    matches!(
+        p.extension().and_then(|e| e.to_str()),
+        Some("off" | "poly" | "smesh" | "mesh" | "node")
+    )
+}
+
 /// The referee's verdict on a mesh of `model` (`extra` adds its switches): its report
 /// if it rejects the mesh.
 fn referee(script: &Path, model: &Path, prefix: &Path, extra: &[&str]) -> Result<(), String> {
@@ -303,6 +312,9 @@ fn every_model_passes_the_validator() {
     let failures = for_each_parallel(&models, |m| {
         let name = file_name(m);
         let prefix = dir.path().join(&name);
+        if !referee_reads(m) {
+            return None;
+        }
         let (code, err) = run(m, &prefix, &["-pQ"]);
         if code != 0 {
             return Some(format!("{name}: `tetcdt -pQ` exit {code}: {err}"));
@@ -345,10 +357,10 @@ fn identical_to_tetgen_where_it_adds_no_steiner_points() {
     );
     let dir = tempfile::tempdir().unwrap();
     let failures = for_each_parallel(&refs, |ele| {
-        // NAME.1.ele -> NAME.{off,poly,smesh}
+        // NAME.1.ele -> NAME.{off,poly,smesh,stl,ply}
         let stem = file_name(ele);
         let stem = stem.strip_suffix(".1.ele").unwrap();
-        let Some(input) = ["off", "poly", "smesh"]
+        let Some(input) = ["off", "poly", "smesh", "stl", "ply"]
             .iter()
             .map(|e| plc_dir().join(format!("{stem}.{e}")))
             .find(|p| p.is_file())
@@ -583,11 +595,10 @@ fn flat_tets_get_free_points_inserted_into_the_cdt() {
 }
 
 #[test]
-fn flat_tets_left_on_a_facet_are_counted_and_reported() {
+fn flat_tets_left_on_a_facet_fail_the_run() {
     // anchor.off's flat tets need a free point. With -S leaving no room for one, the flat
-    // tet stays: the run still succeeds, but says so (a warning, and the figure), where
-    // it used to say nothing, and `--check` fails it; with room, nothing is left and
-    // nothing is said.
+    // tet stays, and the certifier fails the run; with room, nothing is left and nothing
+    // is said.
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/nonflat/anchor.off");
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("s.json");
@@ -603,38 +614,29 @@ fn flat_tets_left_on_a_facet_are_counted_and_reported() {
     let all = json_number(&stats, "steiner_points");
     let free = json_number(&stats, "free_steiner_points");
     assert!(free >= 1, "{stats}");
-    // Fewer Steiner points allowed: the first limit that still meshes, with no room for
-    // a free point, leaves a flat tet (a limit too low for the segments fails instead).
+    // Fewer Steiner points allowed: a limit that leaves no room for the free points
+    // leaves a flat tet, and the run fails (exit 1) naming it as a shim rather than
+    // writing a mesh that is no CDT (a limit too low for the segments fails earlier).
     let mut seen = false;
+    let prefix = dir.path().join("limited");
     for limit in (all.saturating_sub(free + 4)..all).rev() {
-        let (code, err) = run(
-            &m,
-            &prefix,
-            &["-p", &format!("-S{limit}"), "--stats-json", json_arg],
-        );
-        if code != 0 {
+        let _ = fs::remove_file(with_ext(&prefix, "ele"));
+        let (code, err) = run(&m, &prefix, &["-p", &format!("-S{limit}")]);
+        if code == 0 {
             continue;
         }
-        let stats = std::fs::read_to_string(&json).unwrap();
-        if json_number(&stats, "free_steiner_points") > 0 {
-            continue;
+        assert_eq!(code, 1, "-S{limit}: {err}");
+        if err.contains("is a shim") {
+            assert!(err.contains("is not a valid CDT"), "-S{limit}: {err}");
+            assert!(
+                !with_ext(&prefix, "ele").exists(),
+                "-S{limit}: a mesh was written"
+            );
+            seen = true;
+            break;
         }
-        let left = json_number(&stats, "flat_tets_left");
-        assert!(left >= 1, "-S{limit}: {stats}");
-        assert!(
-            err.contains(&format!(
-                "{left} flat tet(s) with all four vertices on one facet"
-            )),
-            "-S{limit}: {err}"
-        );
-        // The mesh's own check finds it too, as a shim, and fails the run.
-        let (code, err) = run(&m, &prefix, &["-p", &format!("-S{limit}"), "--check"]);
-        assert_eq!(code, 1, "-S{limit} --check: {err}");
-        assert!(err.contains("is a shim"), "-S{limit} --check: {err}");
-        seen = true;
-        break;
     }
-    assert!(seen, "no limit below {all} meshed without free points");
+    assert!(seen, "no limit below {all} left a flat tet");
 }
 
 /// The number after `"key":` in a one-line JSON object.
@@ -886,5 +888,120 @@ fn stl_cdt_is_tetgens_with_tetgens_numbering() {
             points(&theirs),
             "{name}.stl: other points"
         );
+    }
+}
+
+/// The faces of `PREFIX.face` with their markers, as coordinates.
+fn marked_faces(prefix: &Path) -> Vec<([[f64; 3]; 3], i32)> {
+    let m = read_mesh(prefix);
+    let r = rows(&with_ext(prefix, "face"));
+    let n: usize = r[0][0].parse().unwrap();
+    let first: usize = r[1][0].parse().unwrap();
+    r[1..=n]
+        .iter()
+        .map(|row| {
+            let v = |k: usize| m.points[row[k].parse::<usize>().unwrap() - first];
+            ([v(1), v(2), v(3)], row[4].parse().unwrap())
+        })
+        .collect()
+}
+
+/// Windows (hole polygons with hole points that other facets fill) mesh as TetGen
+/// meshes them (`identical_to_tetgen_where_it_adds_no_steiner_points` has their
+/// references): each window's triangles carry the filling facet's marker, the walls'
+/// carry the wall's, and a window filled by a facet of the wall's own marker is part of
+/// the wall.
+#[test]
+fn windows_carry_the_markers_of_the_facets_that_fill_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = mesh(&model("windows.poly"), dir.path(), "w", &["-pQ"]);
+    // Each window: the marker of its filling facet, the plane it lies in (axis, value)
+    // and its rectangle in the other two coordinates.
+    let windows: [(i32, usize, f64, [f64; 4]); 4] = [
+        (5, 1, 0.0, [1.0, 2.0, 1.0, 2.0]),
+        (6, 1, 0.0, [3.5, 5.0, 0.5, 2.5]),
+        (7, 0, 6.0, [1.0, 3.0, 1.0, 2.0]),
+        (8, 1, 4.0, [4.0, 5.0, 1.0, 2.0]),
+    ];
+    let faces = marked_faces(&prefix);
+    let mut per_window = [0; 4];
+    for (f, marker) in &faces {
+        let c: [f64; 3] = std::array::from_fn(|k| (f[0][k] + f[1][k] + f[2][k]) / 3.0);
+        let inside = windows.iter().position(|&(_, axis, at, r)| {
+            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+            let (a, b) = if axis == 1 {
+                (c[w], c[u])
+            } else {
+                (c[u], c[w])
+            };
+            f.iter().all(|p| p[axis] == at) && r[0] <= a && a <= r[1] && r[2] <= b && b <= r[3]
+        });
+        match inside {
+            Some(k) => {
+                assert_eq!(*marker, windows[k].0, "face {f:?}");
+                per_window[k] += 1;
+            }
+            None => assert_eq!(*marker, 1, "face {f:?}"),
+        }
+    }
+    assert_eq!(per_window, [2, 2, 2, 2], "the windows' triangles");
+}
+
+/// Triangles whose corners repeat once exactly equal points are welded add nothing:
+/// every format drops them with one warning naming them, and meshes the rest as the
+/// same model without them (its tets are TetGen's: see `data/plc/ref/`).
+#[test]
+fn triangles_with_a_repeated_corner_are_dropped_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = read_mesh(&mesh(
+        &model("degenerate_tris.off"),
+        dir.path(),
+        "off",
+        &["-p"],
+    ));
+    for (name, facets) in [
+        (
+            "degenerate_tris.off",
+            "facet 5 (line 19), facet 11 (line 25)",
+        ),
+        (
+            "degenerate_tris_obj.obj",
+            "facet 6 (line 17), facet 12 (line 23)",
+        ),
+        (
+            "degenerate_tris_ply.ply",
+            "facet 5 (line 26), facet 11 (line 32)",
+        ),
+        (
+            "degenerate_tris_ascii.stl",
+            "facet 6 (line 37), facet 12 (line 79)",
+        ),
+        ("degenerate_tris_binary.stl", "facet 6, facet 12"),
+    ] {
+        let prefix = dir.path().join(name);
+        let (code, err) = run(&model(name), &prefix, &["-p"]);
+        assert_eq!(code, 0, "{name}: {err}");
+        assert!(
+            err.contains(&format!(
+                "2 facet(s) with a repeated corner (two corners at the same point) add nothing to the surface and were dropped: {facets}"
+            )),
+            "{name}: {err}"
+        );
+        // The STL files hold the coordinates as floats: tets are compared at that
+        // precision.
+        let as_f32 = |m: &Mesh| -> BTreeSet<Vec<[u32; 3]>> {
+            m.tets
+                .iter()
+                .map(|t| {
+                    let mut k: Vec<[u32; 3]> = t
+                        .iter()
+                        .map(|&v| m.points[v].map(|c| (c as f32).to_bits()))
+                        .collect();
+                    k.sort_unstable();
+                    k
+                })
+                .collect()
+        };
+        assert_eq!(as_f32(&read_mesh(&prefix)), as_f32(&base), "{name}");
     }
 }

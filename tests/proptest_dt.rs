@@ -6,22 +6,41 @@ use proptest::prelude::*;
 use tetcdt::check::check_mesh;
 use tetcdt::{tetrahedralize, Options, Plc};
 
+/// Whether the points span no volume: all on one plane (exactly), which includes
+/// collinear and coincident ones.
+fn degenerate(points: &[[f64; 3]]) -> bool {
+    let ids: Vec<u32> = (0..points.len() as u32).collect();
+    let Some(k) =
+        (2..points.len()).find(|&k| !tetcdt::geom::polygon::all_collinear(points, &ids[..=k]))
+    else {
+        return true;
+    };
+    // Points 0..=k span a plane: two of them and point k, not collinear.
+    let a = points[0];
+    let b = *points[..k].iter().find(|p| **p != a).unwrap_or(&a);
+    let c = points[k];
+    points
+        .iter()
+        .all(|q| tetcdt::geom::orient3d(&a, &b, &c, q) == 0.0)
+}
+
 fn mesh_and_check(points: Vec<[f64; 3]>) -> Result<(), TestCaseError> {
-    let plc = Plc::from_points(points, 1);
+    let plc = Plc::from_points(points.clone(), 1);
     match tetrahedralize(&plc, &Options::default()) {
         Ok(m) => {
-            if let Err(problems) = check_mesh(&plc, &m.mesh) {
+            if let Err(problems) = check_mesh(&plc, &m.mesh, &Default::default()) {
                 return Err(TestCaseError::fail(problems.to_string()));
             }
             Ok(())
         }
-        // Coplanar, collinear or too few distinct points: a clear error is the right answer.
+        // Only a set that spans no volume may be refused, as an invalid input.
         Err(e) => {
-            let msg = e.to_string();
             prop_assert!(
-                msg.contains("coplanar") || msg.contains("collinear") || msg.contains("distinct"),
-                "unexpected error: {msg}"
+                degenerate(&points),
+                "refused points that span a volume: {}",
+                e
             );
+            prop_assert_eq!(e.exit_code(), 3, "{}", e);
             Ok(())
         }
     }

@@ -1,32 +1,56 @@
-//! The mesh validator behind `--check`: an independent check of a finished mesh against
-//! its input, working on the flat output arrays rather than on the arena.
+//! The certifier behind `--certify` and `--check`: decides from a mesh's nodes and tets
+//! alone, with exact predicates, whether it is a constrained Delaunay tetrahedralization
+//! (with Steiner points) of a PLC, or the Delaunay tetrahedralization of a point set. It
+//! reads nothing the mesher keeps (no list of subfaces or subsegments), so it judges any
+//! mesh, TetGen's included.
 //!
-//! For a point set it verifies that the tets are positively oriented, that faces are
-//! shared by at most two tets lying on opposite sides, that the neighbour table agrees,
-//! that the boundary is a closed locally convex surface enclosing the tets' volume with
-//! every input point used (so the tets tile the convex hull), and that every face is
-//! locally Delaunay under the symbolic perturbation. For a PLC it verifies instead that
-//! every unconstrained face is locally Delaunay, that the constraints are in the mesh and
-//! the boundary lies on them, that no input point is lost inside the mesh, and that no
-//! shim tet survives (`shims.rs`: a flat tet with all four vertices on one facet, as the
-//! shared referee counts them).
+//! The checks:
+//! * every tet is positively oriented, each face belongs to one or two tets, and two tets
+//!   sharing a face lie on its two sides;
+//! * the tets tile the domain: each face-connected part of the mesh has a point held by
+//!   exactly one tet (with the checks above, the number of tets holding a point is the
+//!   winding number of the boundary around it, constant over each part), and hole points
+//!   and input points left out of the mesh lie in no tet;
+//! * every input segment is a chain of mesh edges, every facet is covered exactly once
+//!   by the faces on it and no face lies outside it, and no shim tet (a flat tet with all
+//!   four nodes on one facet) survives (`facets.rs`);
+//! * every face on no facet is locally Delaunay under TetGen's symbolic perturbation, by
+//!   node number; the boundary lies on facets (with `-c`, on the convex hull).
 
-mod shims;
+mod facets;
+mod locate;
+mod topology;
 
+use crate::error::InputError;
 use crate::geom::{insphere_sos, orient3d, Point, Sign};
-use crate::mesh::{EDGE_VERTS, FACE_VERTS};
 use crate::output::MeshOut;
+use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
+use rayon::prelude::*;
 
 /// Stop collecting after this many problems; the count of the rest is reported.
 const MAX_REPORTED: usize = 20;
 
-struct Problems {
+/// The problems found so far, and how the mesh and the input number their elements.
+pub(crate) struct Problems {
     list: Vec<String>,
     more: usize,
+    /// The number of the first node.
+    base: usize,
+    /// The number of the first input facet.
+    facet_base: usize,
 }
 
 impl Problems {
+    fn new(base: usize, facet_base: usize) -> Self {
+        Problems {
+            list: Vec::new(),
+            more: 0,
+            base,
+            facet_base,
+        }
+    }
+
     fn push(&mut self, msg: String) {
         if self.list.len() < MAX_REPORTED {
             self.list.push(msg);
@@ -34,6 +58,19 @@ impl Problems {
             self.more += 1;
         }
     }
+
+    fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// Takes in the problems `other` found.
+    fn absorb(&mut self, other: Problems) {
+        for p in other.list {
+            self.push(p);
+        }
+        self.more += other.more;
+    }
+
     fn finish(self) -> Result<(), CheckFailure> {
         if self.list.is_empty() {
             Ok(())
@@ -46,6 +83,16 @@ impl Problems {
     }
 }
 
+/// Node `v` as numbered in the mesh's files.
+fn name(pr: &Problems, v: u32) -> usize {
+    v as usize + pr.base
+}
+
+/// Nodes as numbered in the mesh's files.
+fn names(pr: &Problems, t: &[u32]) -> Vec<usize> {
+    t.iter().map(|&v| name(pr, v)).collect()
+}
+
 /// What a failed check found: the first problems, a line each, and how many there are.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CheckFailure {
@@ -53,6 +100,18 @@ pub struct CheckFailure {
     pub listed: Vec<String>,
     /// How many problems there are in all, listed or not.
     pub total: usize,
+}
+
+impl CheckFailure {
+    /// The count of problems and the listed ones, one per indented line.
+    pub fn report(&self) -> String {
+        let mut msg = format!("{} problem(s):", self.total);
+        for p in self.to_string().lines() {
+            msg.push_str("\n  ");
+            msg.push_str(p);
+        }
+        msg
+    }
 }
 
 impl std::fmt::Display for CheckFailure {
@@ -70,829 +129,592 @@ impl std::fmt::Display for CheckFailure {
     }
 }
 
-/// A face of a tet: sorted vertex key, the tet, and the local face index.
-#[derive(Copy, Clone, PartialEq, Eq, PartialOrd, Ord)]
-struct FaceEntry {
-    key: [u32; 3],
-    tet: u32,
-    face: u8,
+/// Why a mesh could not be certified.
+#[derive(Debug, thiserror::Error)]
+pub enum CertifyError {
+    /// The PLC itself is invalid, so no mesh is a CDT of it.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// The mesh is not a CDT of the PLC.
+    #[error("{0}")]
+    Failed(CheckFailure),
 }
 
-/// Checks `mesh` against `plc`; returns the problems found (empty means valid).
-pub fn check_mesh(plc: &Plc, mesh: &MeshOut) -> Result<(), CheckFailure> {
-    let mut pr = Problems {
-        list: Vec::new(),
-        more: 0,
+/// How the mesh was meant to be made, which changes what it must be.
+#[derive(Clone, Copy, Debug)]
+pub struct CertifyOptions {
+    /// The exterior was kept (`-c`): the boundary lies on the convex hull, not only on
+    /// polygons.
+    pub keep_hull: bool,
+    /// Coplanar neighbouring facets are merged (TetGen's default; `-M` keeps them apart):
+    /// their common edges need not be meshed.
+    pub merge: bool,
+}
+
+impl CertifyOptions {
+    /// What the switches of a run say the mesh must be.
+    pub fn of(opts: &crate::options::Options) -> Self {
+        CertifyOptions {
+            keep_hull: opts.keep_hull,
+            merge: !opts.no_merge,
+        }
+    }
+}
+
+impl Default for CertifyOptions {
+    fn default() -> Self {
+        CertifyOptions {
+            keep_hull: false,
+            merge: true,
+        }
+    }
+}
+
+/// What a certified mesh holds.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Certificate {
+    /// Tets.
+    pub tets: usize,
+    /// Nodes that are no input point.
+    pub steiner_points: usize,
+    /// Faces on facets.
+    pub subfaces: usize,
+    /// Edges on segments.
+    pub subsegments: usize,
+}
+
+/// A mesh to certify: its nodes and tets (0-based), and the number its files give the
+/// first node (for messages).
+#[derive(Clone, Copy, Debug)]
+pub struct MeshView<'a> {
+    /// Node coordinates.
+    pub points: &'a [Point],
+    /// Tets, as node indices, positively oriented in TetGen's sense.
+    pub tets: &'a [[u32; 4]],
+    /// The number of the first node in the files.
+    pub first_index: usize,
+}
+
+/// Certifies `mesh` as a CDT of `plc` (of its points alone when it has no facets).
+pub fn certify(
+    plc: &Plc,
+    mesh: MeshView<'_>,
+    opts: &CertifyOptions,
+) -> Result<Certificate, CertifyError> {
+    let prep = if plc.facets.is_empty() {
+        None
+    } else {
+        Some(crate::plc::prepare::prepare(plc, opts.merge)?)
     };
-    let pts = &mesh.points;
-    let n = pts.len();
-    let base = mesh.first_index;
-    for (i, t) in mesh.tets.iter().enumerate() {
+    certify_prepared(plc, prep.as_ref(), mesh, opts).map_err(CertifyError::Failed)
+}
+
+/// [`certify`] with the PLC already prepared (`None` for a point set).
+pub fn certify_prepared(
+    plc: &Plc,
+    prep: Option<&PreparedPlc>,
+    mesh: MeshView<'_>,
+    opts: &CertifyOptions,
+) -> Result<Certificate, CheckFailure> {
+    let MeshView {
+        points,
+        tets,
+        first_index,
+    } = mesh;
+    let mut pr = Problems::new(first_index, plc.first_index);
+    let n = points.len();
+    for (i, t) in tets.iter().enumerate() {
         let bad_index = t.iter().any(|&v| v as usize >= n);
         let repeated = (0..4).any(|a| (a + 1..4).any(|b| t[a] == t[b]));
         if bad_index || repeated {
-            pr.push(format!("tet {} has invalid vertices {:?}", i + base, t));
-        }
-    }
-    if !pr.list.is_empty() {
-        return pr.finish();
-    }
-    let p = |v: u32| -> &Point { &pts[v as usize] };
-    let vol6 = |t: &[u32; 4]| orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
-    for (i, t) in mesh.tets.iter().enumerate() {
-        if vol6(t) <= 0.0 {
             pr.push(format!(
-                "tet {} {:?} is not positively oriented",
-                i + base,
-                shift(t, base)
+                "tet {} has invalid nodes {:?}",
+                i + first_index,
+                t.iter()
+                    .map(|&v| v as usize + first_index)
+                    .collect::<Vec<_>>()
             ));
         }
     }
-
-    // Pair the faces by sorting; every face must have one or two tets.
-    let mut faces: Vec<FaceEntry> = Vec::with_capacity(mesh.tets.len() * 4);
-    for (i, t) in mesh.tets.iter().enumerate() {
-        for (f, fv) in FACE_VERTS.iter().enumerate() {
-            let mut key = [t[fv[0]], t[fv[1]], t[fv[2]]];
-            key.sort_unstable();
-            faces.push(FaceEntry {
-                key,
-                tet: i as u32,
-                face: f as u8,
-            });
-        }
+    if tets.is_empty() {
+        pr.push("the mesh has no tets".into());
     }
-    faces.sort_unstable();
-    let subfaces: rustc_hash::FxHashSet<[u32; 3]> = mesh
-        .subfaces
-        .iter()
-        .map(|(f, _)| {
-            let mut k = *f;
-            k.sort_unstable();
-            k
+    if !pr.is_empty() {
+        return pr.finish().map(|()| Certificate::default());
+    }
+    let p = |v: u32| -> &Point { &points[v as usize] };
+    let inverted: Vec<usize> = (0..tets.len())
+        .into_par_iter()
+        .filter(|&i| {
+            let t = &tets[i];
+            orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) <= 0.0
         })
         .collect();
-    let mut boundary: Vec<(u32, u8)> = Vec::new();
-    let mut k = 0;
-    while k < faces.len() {
-        let mut j = k + 1;
-        while j < faces.len() && faces[j].key == faces[k].key {
-            j += 1;
-        }
-        match j - k {
-            1 => boundary.push((faces[k].tet, faces[k].face)),
-            2 => {
-                let constrained = subfaces.contains(&faces[k].key);
-                check_interior_face(mesh, faces[k], faces[k + 1], constrained, &mut pr)
-            }
-            m => pr.push(format!(
-                "face {:?} is shared by {m} tets",
-                faces[k].key.map(|v| v as usize + base)
-            )),
-        }
-        k = j;
+    for i in inverted {
+        pr.push(format!(
+            "tet {} {:?} is not positively oriented",
+            i + first_index,
+            names(&pr, &tets[i])
+        ));
     }
-    drop(faces);
-    check_hull_faces(mesh, &mut boundary, &mut pr);
-    check_boundary(mesh, &boundary, &mut pr);
-    if mesh.plc_mode {
-        // Each input point's first copy, which stands for its duplicates in the mesh.
-        let rep = crate::precheck::representatives(&plc.points);
-        check_constraints(plc, mesh, &rep, &subfaces, &boundary, &mut pr);
-        check_points_kept(plc, mesh, &rep, &mut pr);
-        check_shims(plc, mesh, &rep, &mut pr);
+    let stars = facets::Rows::stars(n, tets);
+    let topo = topology::Topology::build(tets, &stars, n, &mut pr);
+    let same_side: Vec<(u32, u32)> = topo
+        .pairs()
+        .filter(|&(a, b)| {
+            let (ta, fa) = topology::split(a);
+            let (tb, fb) = topology::split(b);
+            let f = topology::oriented_face(&tets[ta], fa);
+            orient3d(p(f[0]), p(f[1]), p(f[2]), p(tets[tb][fb])) >= 0.0
+        })
+        .collect();
+    for (a, b) in same_side {
+        pr.push(format!(
+            "tets {} and {} lie on the same side of their face {:?}",
+            (a >> 2) as usize + first_index,
+            (b >> 2) as usize + first_index,
+            names(&pr, &topology::key(tets, a))
+        ));
+    }
+    let node = facets::nodes_of_inputs(&plc.points, points);
+    let mut cert = Certificate {
+        tets: tets.len(),
+        steiner_points: n - {
+            let mut v: Vec<u32> = node.iter().copied().filter(|&x| x != u32::MAX).collect();
+            v.sort_unstable();
+            v.dedup();
+            v.len()
+        },
+        ..Default::default()
+    };
+    // The constraints on one core; the local Delaunay tests of every face and the
+    // tiling on the other (faces on facets are exempted afterwards).
+    let mut other = Problems::new(first_index, plc.first_index);
+    let (found, not_delaunay) = rayon::join(
+        || {
+            prep.map(|prep| {
+                missing_vertices(plc, prep, &node, &mut pr);
+                let keys: Vec<[u32; 3]> = topo
+                    .boundary
+                    .iter()
+                    .map(|&s| topology::key(tets, s))
+                    .chain(
+                        topo.pairs()
+                            .map(|(s, _)| topology::key(tets, s))
+                            .collect::<Vec<_>>(),
+                    )
+                    .collect();
+                facets::find(
+                    prep,
+                    &node,
+                    points,
+                    tets,
+                    &stars,
+                    &keys,
+                    plc.points.len(),
+                    &mut pr,
+                )
+            })
+        },
+        || {
+            let bad: Vec<(u32, u32)> = topo
+                .pairs()
+                .filter(|&(a, b)| !is_delaunay(points, tets, a, b))
+                .collect();
+            check_tiling(points, tets, &topo, &mut other);
+            bad
+        },
+    );
+    pr.absorb(other);
+    let mut locator = locate::Locator::new(points, tets);
+    let subfaces = match (prep, &found) {
+        (Some(prep), Some(found)) => {
+            uncovered_facets(prep, found, &mut locator, &mut pr);
+            cert.subfaces = found.subfaces.len();
+            cert.subsegments = found.chains.iter().map(|c| c.len().saturating_sub(1)).sum();
+            Some(&found.subfaces)
+        }
+        _ => {
+            unused_points(plc, &node, points, tets, &mut pr);
+            None
+        }
+    };
+    let on_facet = |k: &[u32; 3]| subfaces.is_some_and(|s| s.contains_key(k));
+    for (a, b) in not_delaunay {
+        let k = topology::key(tets, a);
+        if !on_facet(&k) {
+            pr.push(format!(
+                "face {:?} between tets {} and {} lies on no facet and is not locally Delaunay",
+                names(&pr, &k),
+                (a >> 2) as usize + first_index,
+                (b >> 2) as usize + first_index
+            ));
+        }
+    }
+    check_boundary(tets, &topo.boundary, &mut pr);
+    let hull_only = prep.is_none() || opts.keep_hull;
+    for &s in &topo.boundary {
+        let k = topology::key(tets, s);
+        if !on_facet(&k) && !hull_only {
+            pr.push(format!(
+                "boundary face {:?} lies on no facet",
+                names(&pr, &k)
+            ));
+        }
+    }
+    if hull_only {
+        check_hull(points, tets, &topo.boundary, on_facet, &mut pr);
+    }
+    if prep.is_some() {
+        points_outside(plc, &node, points, tets, &mut locator, &mut pr);
+    }
+    pr.finish()?;
+    Ok(cert)
+}
+
+/// Whether the face between slots `a` and `b` is locally Delaunay: `b`'s other node
+/// outside `a`'s tet's circumsphere, ties broken by the symbolic perturbation by node
+/// number.
+fn is_delaunay(points: &[Point], tets: &[[u32; 4]], a: u32, b: u32) -> bool {
+    let (ta, _) = topology::split(a);
+    let (tb, fb) = topology::split(b);
+    let t = tets[ta];
+    let q = [t[0], t[1], t[2], t[3], tets[tb][fb]];
+    insphere_sos(q.map(|v| &points[v as usize]), q) == Sign::Negative
+}
+
+/// The boundary must be a closed surface: every edge of the boundary faces in as many
+/// of them seen one way as the other (two solids may touch along an edge).
+fn check_boundary(tets: &[[u32; 4]], boundary: &[u32], pr: &mut Problems) {
+    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(3 * boundary.len());
+    for &s in boundary {
+        let (t, f) = topology::split(s);
+        let fv = topology::oriented_face(&tets[t], f);
+        for k in 0..3 {
+            let (a, b) = (fv[k], fv[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b), a < b));
+        }
+    }
+    edges.par_sort_unstable();
+    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let forward = run.iter().filter(|e| e.2).count();
+        if 2 * forward != run.len() {
+            pr.push(format!(
+                "boundary edge ({}, {}) is in {} boundary faces, not paired by opposite sides",
+                name(pr, run[0].0),
+                name(pr, run[0].1),
+                run.len()
+            ));
+        }
+    }
+}
+
+/// Boundary faces that lie on no facet must lie on the convex hull: at every edge they
+/// share with another such face the two meet convexly, and where coplanar, they are
+/// Delaunay under the perturbation (TetGen's hull triangulation).
+fn check_hull(
+    points: &[Point],
+    tets: &[[u32; 4]],
+    boundary: &[u32],
+    on_facet: impl Fn(&[u32; 3]) -> bool,
+    pr: &mut Problems,
+) {
+    let hull: Vec<u32> = boundary
+        .iter()
+        .copied()
+        .filter(|&s| !on_facet(&topology::key(tets, s)))
+        .collect();
+    let face = |s: u32| {
+        let (t, f) = topology::split(s);
+        topology::oriented_face(&tets[t], f)
+    };
+    let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * hull.len());
+    for &s in &hull {
+        let fv = face(s);
+        for k in 0..3 {
+            let (a, b) = (fv[k], fv[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b), s));
+        }
+    }
+    edges.par_sort_unstable();
+    let p = |v: u32| &points[v as usize];
+    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let [e1, e2] = run else { continue };
+        let (face1, face2) = (face(e1.2), face(e2.2));
+        let Some(&x) = face2.iter().find(|v| !face1.contains(v)) else {
+            continue;
+        };
+        let o = orient3d(p(face1[0]), p(face1[1]), p(face1[2]), p(x));
+        if o < 0.0 {
+            pr.push(format!(
+                "the boundary is not convex at faces {:?} and {:?}",
+                names(pr, &face1),
+                names(pr, &face2)
+            ));
+        } else if o == 0.0 {
+            let t1 = tets[(e1.2 >> 2) as usize];
+            let q = [t1[0], t1[1], t1[2], t1[3], x];
+            if insphere_sos(q.map(p), q) != Sign::Negative {
+                pr.push(format!(
+                    "coplanar hull faces {:?} and {:?} are not Delaunay",
+                    names(pr, &face1),
+                    names(pr, &face2)
+                ));
+            }
+        }
+    }
+}
+
+/// The tets tile the domain: in each face-connected part of the mesh, a point inside one
+/// of its tets lies in no other tet.
+fn check_tiling(points: &[Point], tets: &[[u32; 4]], topo: &topology::Topology, pr: &mut Problems) {
+    let mut dsu = crate::plc::prepare::Dsu((0..tets.len()).collect());
+    for (s, &o) in topo.adj.iter().enumerate() {
+        if o != topology::NONE && (s as u32) < o {
+            dsu.union(s >> 2, (o >> 2) as usize);
+        }
+    }
+    let mut parts: Vec<(usize, usize)> = (0..tets.len()).map(|t| (dsu.find(t), t)).collect();
+    parts.sort_unstable();
+    let parts: Vec<&[(usize, usize)]> = parts.chunk_by(|x, y| x.0 == y.0).collect();
+    let mut locator = locate::Locator::new(points, tets);
+    locator.expect(parts.len());
+    // Points inside a tet: its centroid, else points nearer one corner (a centroid can
+    // round onto a face of a very flat tet).
+    const WEIGHTS: [[f64; 4]; 5] = [
+        [0.25; 4],
+        [0.4, 0.2, 0.2, 0.2],
+        [0.2, 0.4, 0.2, 0.2],
+        [0.2, 0.2, 0.4, 0.2],
+        [0.2, 0.2, 0.2, 0.4],
+    ];
+    for part in parts {
+        // A point that falls on another tet's boundary says nothing: try others. A part
+        // whose tets are all too flat to hold a floating-point point strictly inside is
+        // left to the local checks (orientation, opposite sides, the boundary).
+        let samples = part
+            .iter()
+            .take(64)
+            .flat_map(|&(_, t)| WEIGHTS.iter().map(move |w| (t, w)));
+        for (t, w) in samples {
+            let tv = tets[t];
+            let c: Point = std::array::from_fn(|k| {
+                (0..4)
+                    .map(|i| w[i] * points[tv[i] as usize][k])
+                    .sum::<f64>()
+            });
+            if locate::in_tet(points, &tv, &c) != locate::InTet::Inside {
+                continue;
+            }
+            let (inside, on) = locator.count(&c);
+            if on > 0 && inside == 1 {
+                continue;
+            }
+            if inside != 1 {
+                pr.push(format!(
+                    "the tets overlap: a point inside tet {} lies in {} tets",
+                    t + pr.base,
+                    inside + on
+                ));
+            }
+            break;
+        }
+    }
+}
+
+/// Every vertex of a polygon must be a mesh node.
+fn missing_vertices(plc: &Plc, prep: &PreparedPlc, node: &[u32], pr: &mut Problems) {
+    let mut used = vec![false; plc.points.len()];
+    for f in &prep.facets {
+        let verts = f
+            .rings
+            .iter()
+            .flatten()
+            .chain(f.inner_segments.iter().flatten())
+            .chain(&f.isolated);
+        for &v in verts {
+            used[v as usize] = true;
+        }
+    }
+    for (i, &u) in used.iter().enumerate() {
+        if u && node[i] == u32::MAX {
+            let q = plc.points[i];
+            pr.push(format!(
+                "input point {} ({}, {}, {}) of a polygon is not a mesh node",
+                i + plc.first_index,
+                q[0],
+                q[1],
+                q[2]
+            ));
+        }
+    }
+}
+
+/// A facet without faces on it must lie outside the domain: a point inside it in no tet.
+fn uncovered_facets(
+    prep: &PreparedPlc,
+    found: &facets::Constraints,
+    locator: &mut locate::Locator,
+    pr: &mut Problems,
+) {
+    locator.expect(found.bare.len());
+    for &(g, q) in &found.bare {
+        if let Some(t) = locator.holder(&q) {
+            pr.push(format!(
+                "facet {} has no faces on it, but passes through tet {}",
+                facets::facet_label(&prep.facets[g as usize], pr),
+                t as usize + pr.base
+            ));
+        }
+    }
+}
+
+/// PLC meshes: hole points, and input points that are no mesh node, lie in no tet.
+fn points_outside(
+    plc: &Plc,
+    node: &[u32],
+    points: &[Point],
+    tets: &[[u32; 4]],
+    locator: &mut locate::Locator,
+    pr: &mut Problems,
+) {
+    locator.expect(plc.holes.len());
+    for (i, h) in plc.holes.iter().enumerate() {
+        if let Some(t) = locator.holder(h) {
+            pr.push(format!(
+                "hole point {} lies in tet {}",
+                i + plc.first_index,
+                t as usize + pr.base
+            ));
+        }
+    }
+    let mut used = vec![false; points.len()];
+    for t in tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut reported = 0;
+    for (i, q) in plc.points.iter().enumerate() {
+        let in_mesh = node[i] != u32::MAX && used[node[i] as usize];
+        if in_mesh || reported >= MAX_REPORTED {
+            continue;
+        }
+        if let Some(t) = locator.holder(q) {
+            reported += 1;
+            pr.push(format!(
+                "input point {} lies in tet {} but is not a mesh node",
+                i + plc.first_index,
+                t as usize + pr.base
+            ));
+        }
+    }
+}
+
+/// Point sets: every input point is a node of some tet.
+fn unused_points(plc: &Plc, node: &[u32], points: &[Point], tets: &[[u32; 4]], pr: &mut Problems) {
+    let mut used = vec![false; points.len()];
+    for t in tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    for (i, &x) in node.iter().enumerate() {
+        if x == u32::MAX || !used[x as usize] {
+            pr.push(format!(
+                "input point {} is not a vertex of the mesh",
+                i + plc.first_index
+            ));
+        }
+    }
+}
+
+/// `--check`: certifies the mesh as written (without the points no tet uses), then the
+/// tables the mesher wrote beside it (neighbours, hull faces) against the tets.
+pub fn check_mesh(plc: &Plc, mesh: &MeshOut, opts: &CertifyOptions) -> Result<(), CheckFailure> {
+    let view = MeshView {
+        points: &mesh.points,
+        tets: &mesh.tets,
+        first_index: mesh.first_index,
+    };
+    let prep = if plc.facets.is_empty() || !mesh.plc_mode {
+        None
     } else {
-        check_vertices_used(plc, mesh, &mut pr);
+        match crate::plc::prepare::prepare(plc, opts.merge) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                return Err(CheckFailure {
+                    listed: vec![e.to_string()],
+                    total: 1,
+                })
+            }
+        }
+    };
+    let plc_view;
+    let plc = if mesh.plc_mode {
+        plc
+    } else {
+        // A point set's facets (a .poly meshed without -p) are not constraints.
+        plc_view = Plc {
+            facets: Vec::new(),
+            ..plc.clone()
+        };
+        &plc_view
+    };
+    certify_prepared(plc, prep.as_ref(), view, opts)?;
+    check_tables(mesh)
+}
+
+/// The neighbour table and the hull faces the mesher lists, against the tets.
+fn check_tables(mesh: &MeshOut) -> Result<(), CheckFailure> {
+    let mut pr = Problems::new(mesh.first_index, 0);
+    let base = mesh.first_index;
+    if mesh.neighbors.is_empty() && (mesh.hull_faces.is_empty() || mesh.plc_mode) {
+        return Ok(());
+    }
+    let stars = facets::Rows::stars(mesh.points.len(), &mesh.tets);
+    let topo = topology::Topology::build(&mesh.tets, &stars, mesh.points.len(), &mut pr);
+    if !mesh.neighbors.is_empty() {
+        for (s, &o) in topo.adj.iter().enumerate() {
+            let (t, f) = topology::split(s as u32);
+            let want = if o == topology::NONE {
+                -1
+            } else {
+                i64::from(o >> 2)
+            };
+            if mesh.neighbors[t][f] != want {
+                pr.push(format!(
+                    "the neighbour table disagrees with the tets at face {:?}",
+                    names(&pr, &topology::key(&mesh.tets, s as u32))
+                ));
+            }
+        }
+    }
+    if !mesh.hull_faces.is_empty() && !mesh.plc_mode {
+        if mesh.hull_faces.len() != topo.boundary.len() {
+            pr.push(format!(
+                "the mesh lists {} hull faces but has {} boundary faces",
+                mesh.hull_faces.len(),
+                topo.boundary.len()
+            ));
+        } else {
+            for (k, (&s, h)) in topo.boundary.iter().zip(&mesh.hull_faces).enumerate() {
+                let (t, f) = topology::split(s);
+                let o = topology::oriented_face(&mesh.tets[t], f);
+                if *h != [o[0], o[2], o[1]] {
+                    pr.push(format!(
+                        "hull face {} {:?} should be {:?} (face {f} of tet {})",
+                        k + base,
+                        names(&pr, h),
+                        names(&pr, &[o[0], o[2], o[1]]),
+                        t + base
+                    ));
+                }
+            }
+        }
     }
     pr.finish()
 }
 
-/// If the mesh lists its hull faces, they must be the boundary faces, reversed (normals
-/// pointing out), in the order of their tets and faces. Sorts `boundary` that way.
-fn check_hull_faces(mesh: &MeshOut, boundary: &mut [(u32, u8)], pr: &mut Problems) {
-    boundary.sort_unstable();
-    if mesh.hull_faces.is_empty() || mesh.plc_mode {
-        return;
-    }
-    let base = mesh.first_index;
-    if mesh.hull_faces.len() != boundary.len() {
-        pr.push(format!(
-            "the mesh lists {} hull faces but has {} boundary faces",
-            mesh.hull_faces.len(),
-            boundary.len()
-        ));
-        return;
-    }
-    for (k, (&(t, f), h)) in boundary.iter().zip(&mesh.hull_faces).enumerate() {
-        let o = oriented_face(&mesh.tets[t as usize], f as usize);
-        if *h != [o[0], o[2], o[1]] {
-            pr.push(format!(
-                "hull face {} {:?} should be {:?} (face {f} of tet {})",
-                k + base,
-                shift(h, base),
-                shift(&[o[0], o[2], o[1]], base),
-                t as usize + base
-            ));
-        }
-    }
-}
-
-/// PLC meshes: every subsegment and subface is in the mesh, every input segment is a
-/// chain of subsegments, every polygon vertex is a mesh vertex, and the boundary of the
-/// mesh lies on polygons (unless the convex hull was kept).
-fn check_constraints(
-    plc: &Plc,
-    mesh: &MeshOut,
-    rep: &[u32],
-    subfaces: &rustc_hash::FxHashSet<[u32; 3]>,
-    boundary: &[(u32, u8)],
-    pr: &mut Problems,
-) {
-    use rustc_hash::{FxHashMap, FxHashSet};
-    let base = mesh.first_index;
-    let mut edges: FxHashSet<(u32, u32)> = FxHashSet::default();
-    let mut faces: FxHashSet<[u32; 3]> = FxHashSet::default();
-    for t in &mesh.tets {
-        for (a, b) in EDGE_VERTS {
-            edges.insert((t[a].min(t[b]), t[a].max(t[b])));
-        }
-        for fv in FACE_VERTS {
-            let mut k = [t[fv[0]], t[fv[1]], t[fv[2]]];
-            k.sort_unstable();
-            faces.insert(k);
-        }
-    }
-    for &([a, b], _) in &mesh.subsegments {
-        if !edges.contains(&(a.min(b), a.max(b))) {
-            pr.push(format!(
-                "subsegment ({}, {}) is not a mesh edge",
-                a as usize + base,
-                b as usize + base
-            ));
-        }
-    }
-    for f in subfaces {
-        if !faces.contains(f) {
-            pr.push(format!("subface {:?} is not a mesh face", shift(f, base)));
-        }
-    }
-    if !mesh.convex_hull_kept {
-        for &(t, f) in boundary {
-            let mut k = oriented_face(&mesh.tets[t as usize], f as usize);
-            k.sort_unstable();
-            if !subfaces.contains(&k) {
-                pr.push(format!(
-                    "boundary face {:?} lies on no polygon",
-                    shift(&k, base)
-                ));
-            }
-        }
-    }
-    // Each polygon edge must be joined up by subsegments running along it.
-    let mut adj: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    for &([a, b], _) in &mesh.subsegments {
-        adj.entry(a).or_default().push(b);
-        adj.entry(b).or_default().push(a);
-    }
-    let mut seen_edges: FxHashSet<(u32, u32)> = FxHashSet::default();
-    for (fi, facet) in plc.facets.iter().enumerate() {
-        for poly in &facet.polygons {
-            let ring: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
-            let n = ring.len();
-            if n < 2 {
-                continue;
-            }
-            let count = if n == 2 { 1 } else { n };
-            for k in 0..count {
-                let (a, b) = (ring[k], ring[(k + 1) % n]);
-                if a == b || !seen_edges.insert((a.min(b), a.max(b))) {
-                    continue;
-                }
-                if !joined_along(mesh, &adj, a, b) {
-                    // Edges between merged coplanar polygons are not constraints: they
-                    // need no subsegments, but their facets still cover them. (A polygon
-                    // that carving would drop is refused by the mesher, so every
-                    // constraint edge must be here.)
-                    if !edges.contains(&(a.min(b), a.max(b))) && is_segment(plc, rep, a, b) {
-                        pr.push(format!(
-                            "facet {}: edge ({}, {}) is not covered by subsegments",
-                            fi + base,
-                            a as usize + base,
-                            b as usize + base
-                        ));
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// No shim tet may survive: a flat tet whose four vertices lie on one (merged) facet.
-fn check_shims(plc: &Plc, mesh: &MeshOut, rep: &[u32], pr: &mut Problems) {
-    let found = shims::shims(plc, mesh, rep);
-    let base = mesh.first_index;
-    for &(t, facet) in &found {
-        pr.push(format!(
-            "tet {} {:?} is a shim: flat, with all four vertices on facet {} (as merged)",
-            t + base,
-            shift(&mesh.tets[t], base),
-            facet + base
-        ));
-    }
-}
-
-/// True if `q` lies in tet `t` (boundary included): exact orientations.
-fn in_tet(mesh: &MeshOut, t: &[u32; 4], q: &Point) -> bool {
-    let w = t.map(|v| mesh.points[v as usize]);
-    let o = orient3d(&w[0], &w[1], &w[2], &w[3]);
-    (0..4).all(|i| {
-        let mut x = w;
-        x[i] = *q;
-        orient3d(&x[0], &x[1], &x[2], &x[3]) * o >= 0.0
-    })
-}
-
-/// PLC meshes: an input point that is no mesh vertex must lie outside the mesh (carved
-/// away with the exterior or a hole), and never inside a tet.
-fn check_points_kept(plc: &Plc, mesh: &MeshOut, rep: &[u32], pr: &mut Problems) {
-    let mut used = vec![false; mesh.points.len()];
-    for t in &mesh.tets {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let unused: Vec<u32> = (0..plc.points.len() as u32)
-        .filter(|&i| rep[i as usize] == i && !used.get(i as usize).copied().unwrap_or(false))
-        .collect();
-    if unused.is_empty() {
-        return;
-    }
-    let p = |v: u32| mesh.points[v as usize];
-    for t in &mesh.tets {
-        let (mut lo, mut hi) = (p(t[0]), p(t[0]));
-        for &v in &t[1..] {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p(v)[k]);
-                hi[k] = hi[k].max(p(v)[k]);
-            }
-        }
-        for &x in &unused {
-            let q = plc.points[x as usize];
-            if (0..3).any(|k| q[k] < lo[k] || q[k] > hi[k]) {
-                continue;
-            }
-            if in_tet(mesh, t, &q) {
-                pr.push(format!(
-                    "input point {} lies in tet {:?} but is not a mesh vertex",
-                    x as usize + mesh.first_index,
-                    shift(t, mesh.first_index)
-                ));
-                return;
-            }
-        }
-    }
-}
-
-/// Is edge `ab` used by a single polygon, or by polygons that are not coplanar? (Then it
-/// is a segment; TetGen drops only edges between coplanar neighbours.)
-fn is_segment(plc: &Plc, rep: &[u32], a: u32, b: u32) -> bool {
-    let mut users = 0;
-    for f in &plc.facets {
-        for poly in &f.polygons {
-            let ring: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
-            let n = ring.len();
-            if n == 2 && ((ring[0] == a && ring[1] == b) || (ring[0] == b && ring[1] == a)) {
-                return true;
-            }
-            if n >= 3
-                && (0..n).any(|k| {
-                    let (x, y) = (ring[k], ring[(k + 1) % n]);
-                    (x == a && y == b) || (x == b && y == a)
-                })
-            {
-                users += 1;
-            }
-        }
-    }
-    users != 2
-}
-
-/// Is there a path of subsegments from `a` to `b` whose vertices stay within rounding
-/// distance of the line through them?
-fn joined_along(
-    mesh: &MeshOut,
-    adj: &rustc_hash::FxHashMap<u32, Vec<u32>>,
-    a: u32,
-    b: u32,
-) -> bool {
-    let pa = mesh.points[a as usize];
-    let pb = mesh.points[b as usize];
-    let d: [f64; 3] = std::array::from_fn(|k| pb[k] - pa[k]);
-    let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    if len2 == 0.0 {
-        return false;
-    }
-    // Steiner points are rounded to the nearest doubles: allow a few ulps of the
-    // coordinates' magnitude.
-    let scale = pa
-        .iter()
-        .chain(pb.iter())
-        .fold(0.0f64, |m, c| m.max(c.abs()));
-    let tol2 = 3.0 * (1e-14 * scale).powi(2) + 1e-300;
-    let on_line = |v: u32| {
-        let p = mesh.points[v as usize];
-        let w: [f64; 3] = std::array::from_fn(|k| p[k] - pa[k]);
-        let t = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / len2;
-        let off: f64 = (0..3).map(|k| (w[k] - t * d[k]).powi(2)).sum();
-        (-1e-9..=1.0 + 1e-9).contains(&t) && off <= tol2
-    };
-    let mut stack = vec![a];
-    let mut seen = rustc_hash::FxHashSet::default();
-    seen.insert(a);
-    while let Some(v) = stack.pop() {
-        if v == b {
-            return true;
-        }
-        for &w in adj.get(&v).map(|x| x.as_slice()).unwrap_or(&[]) {
-            if seen.insert(w) && on_line(w) {
-                stack.push(w);
-            }
-        }
-    }
-    false
-}
-
-fn shift(t: &[u32], base: usize) -> Vec<usize> {
-    t.iter().map(|&v| v as usize + base).collect()
-}
-
-/// The vertices of face `f` of `t`, oriented with `t[f]` on the positive side.
-fn oriented_face(t: &[u32; 4], f: usize) -> [u32; 3] {
-    let fv = FACE_VERTS[f];
-    [t[fv[0]], t[fv[1]], t[fv[2]]]
-}
-
-fn check_interior_face(
-    mesh: &MeshOut,
-    a: FaceEntry,
-    b: FaceEntry,
-    constrained: bool,
-    pr: &mut Problems,
-) {
-    let base = mesh.first_index;
-    let ta = &mesh.tets[a.tet as usize];
-    let tb = &mesh.tets[b.tet as usize];
-    let (fa, fb) = (a.face as usize, b.face as usize);
-    let pts = &mesh.points;
-    // The opposite vertices must lie on opposite sides of the shared face.
-    let f = oriented_face(ta, fa);
-    let e = tb[fb];
-    let side = orient3d(
-        &pts[f[0] as usize],
-        &pts[f[1] as usize],
-        &pts[f[2] as usize],
-        &pts[e as usize],
-    );
-    if side >= 0.0 {
-        pr.push(format!(
-            "tets {} and {} overlap across face {:?}",
-            a.tet as usize + base,
-            b.tet as usize + base,
-            a.key.map(|v| v as usize + base)
-        ));
-        return;
-    }
-    if let Some(nb) = mesh.neighbors.get(a.tet as usize) {
-        if nb[fa] != i64::from(b.tet) || mesh.neighbors[b.tet as usize][fb] != i64::from(a.tet) {
-            pr.push(format!(
-                "neighbour table disagrees at face {:?} of tets {} and {}",
-                a.key.map(|v| v as usize + base),
-                a.tet as usize + base,
-                b.tet as usize + base
-            ));
-        }
-    }
-    // Only faces on polygons may fail to be locally Delaunay (the CDT property).
-    if !constrained {
-        let q = [ta[0], ta[1], ta[2], ta[3], e];
-        let s = insphere_sos(q.map(|v| &pts[v as usize]), q);
-        if s != Sign::Negative {
-            pr.push(format!(
-                "face {:?} between tets {} and {} is not locally Delaunay",
-                a.key.map(|v| v as usize + base),
-                a.tet as usize + base,
-                b.tet as usize + base
-            ));
-        }
-    }
-}
-
-/// The boundary must be a closed surface, each edge in two faces with opposite
-/// directions, locally convex, and enclosing exactly the tets' volume.
-fn check_boundary(mesh: &MeshOut, boundary: &[(u32, u8)], pr: &mut Problems) {
-    let base = mesh.first_index;
-    let pts = &mesh.points;
-    let p = |v: u32| -> &Point { &pts[v as usize] };
-    for &(t, f) in boundary {
-        if let Some(nb) = mesh.neighbors.get(t as usize) {
-            if nb[f as usize] != -1 {
-                pr.push(format!(
-                    "tet {} has a neighbour across its boundary face {}",
-                    t as usize + base,
-                    f
-                ));
-            }
-        }
-    }
-    if boundary.is_empty() {
-        if !mesh.tets.is_empty() {
-            pr.push("the mesh has no boundary".into());
-        }
-        return;
-    }
-    // Directed edges (a, b) of the boundary faces, oriented inward, with the face index.
-    let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(boundary.len() * 3);
-    for (idx, &(t, f)) in boundary.iter().enumerate() {
-        let fv = oriented_face(&mesh.tets[t as usize], f as usize);
-        for k in 0..3 {
-            edges.push((fv[k], fv[(k + 1) % 3], idx as u32));
-        }
-    }
-    let mut undirected: Vec<(u32, u32, u32, bool)> = edges
-        .iter()
-        .map(|&(a, b, i)| (a.min(b), a.max(b), i, a < b))
-        .collect();
-    undirected.sort_unstable();
-    let mut k = 0;
-    while k < undirected.len() {
-        let mut j = k + 1;
-        while j < undirected.len()
-            && (undirected[j].0, undirected[j].1) == (undirected[k].0, undirected[k].1)
-        {
-            j += 1;
-        }
-        let (a, b) = (undirected[k].0, undirected[k].1);
-        let forward = undirected[k..j].iter().filter(|e| e.3).count();
-        // A PLC's boundary may be non-manifold at an edge (two solids touching along
-        // it), but must still pair every face with one of opposite direction.
-        let paired = if mesh.plc_mode {
-            (j - k) % 2 == 0 && 2 * forward == j - k
-        } else {
-            j - k == 2 && forward == 1
-        };
-        if !paired {
-            pr.push(format!(
-                "boundary edge ({}, {}) is in {} boundary faces, not two of opposite sides",
-                a as usize + base,
-                b as usize + base,
-                j - k
-            ));
-        } else if !mesh.plc_mode {
-            let (f1, f2) = (undirected[k].2 as usize, undirected[k + 1].2 as usize);
-            check_hull_edge(mesh, boundary[f1], boundary[f2], pr);
-        }
-        k = j;
-    }
-    // The enclosed volume (divergence theorem) must equal the tets' total volume. Faces
-    // are oriented inward, so each contributes the signed volume of its cone to a centre.
-    // Both sums are rounded, so they are compared within their summed error bounds.
-    let centre = {
-        let v0 = p(boundary_face(mesh, boundary[0])[0]);
-        *v0
-    };
-    let (mut enclosed, mut err) = (0.0, 0.0);
-    for &bf in boundary {
-        let fv = boundary_face(mesh, bf);
-        let (v, e) = volume6_with_error(p(fv[0]), p(fv[1]), p(fv[2]), &centre);
-        enclosed += v;
-        err += e;
-    }
-    let mut total = 0.0;
-    for t in &mesh.tets {
-        let (v, e) = volume6_with_error(p(t[0]), p(t[1]), p(t[2]), p(t[3]));
-        total += v;
-        err += e;
-    }
-    let tol = err + 1e-12 * (enclosed.abs() + total.abs()) + f64::MIN_POSITIVE;
-    if (enclosed - total).abs() > tol {
-        pr.push(format!(
-            "the boundary encloses volume {} but the tets' volumes sum to {}",
-            enclosed / 6.0,
-            total / 6.0
-        ));
-    }
-}
-
-/// The inward-oriented vertices of a boundary face.
-fn boundary_face(mesh: &MeshOut, (t, f): (u32, u8)) -> [u32; 3] {
-    oriented_face(&mesh.tets[t as usize], f as usize)
-}
-
-/// Six times the signed volume of `abcd` in our orientation, in floating point, with a
-/// bound on its rounding error (Shewchuk's first-stage bound on the permanent).
-fn volume6_with_error(a: &Point, b: &Point, c: &Point, d: &Point) -> (f64, f64) {
-    let u = [a[0] - d[0], a[1] - d[1], a[2] - d[2]];
-    let v = [b[0] - d[0], b[1] - d[1], b[2] - d[2]];
-    let w = [c[0] - d[0], c[1] - d[1], c[2] - d[2]];
-    let det = u[2] * (v[0] * w[1] - w[0] * v[1])
-        + v[2] * (w[0] * u[1] - u[0] * w[1])
-        + w[2] * (u[0] * v[1] - v[0] * u[1]);
-    let perm = u[2].abs() * ((v[0] * w[1]).abs() + (w[0] * v[1]).abs())
-        + v[2].abs() * ((w[0] * u[1]).abs() + (u[0] * w[1]).abs())
-        + w[2].abs() * ((u[0] * v[1]).abs() + (v[0] * u[1]).abs());
-    (-det, 1e-15 * perm)
-}
-
-/// At a hull edge the two hull faces must meet convexly; when they are coplanar, the
-/// hull triangulation there must be Delaunay under the perturbation (TetGen's rule).
-fn check_hull_edge(mesh: &MeshOut, f1: (u32, u8), f2: (u32, u8), pr: &mut Problems) {
-    let base = mesh.first_index;
-    let pts = &mesh.points;
-    let t1 = &mesh.tets[f1.0 as usize];
-    let face1 = oriented_face(t1, f1.1 as usize);
-    let face2 = oriented_face(&mesh.tets[f2.0 as usize], f2.1 as usize);
-    let Some(&x) = face2.iter().find(|v| !face1.contains(v)) else {
-        return;
-    };
-    let p = |v: u32| &pts[v as usize];
-    let o = orient3d(p(face1[0]), p(face1[1]), p(face1[2]), p(x));
-    if o < 0.0 {
-        pr.push(format!(
-            "the boundary is not convex at faces {:?} and {:?}",
-            shift(&face1, base),
-            shift(&face2, base)
-        ));
-    } else if o == 0.0 {
-        let q = [t1[0], t1[1], t1[2], t1[3], x];
-        if insphere_sos(q.map(p), q) != Sign::Negative {
-            pr.push(format!(
-                "coplanar hull faces {:?} and {:?} are not Delaunay",
-                shift(&face1, base),
-                shift(&face2, base)
-            ));
-        }
-    }
-}
-
-/// Every input point must be a mesh vertex unless it duplicates an earlier point.
-fn check_vertices_used(plc: &Plc, mesh: &MeshOut, pr: &mut Problems) {
-    let base = mesh.first_index;
-    let mut used = vec![false; mesh.points.len()];
-    for t in &mesh.tets {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let mut unused: Vec<usize> = (0..plc.points.len().min(used.len()))
-        .filter(|&i| !used[i])
-        .collect();
-    if unused.is_empty() {
-        return;
-    }
-    // An unused point is fine only if an identical point is used.
-    let mut by_coord: Vec<usize> = (0..plc.points.len()).collect();
-    let key = |i: usize| plc.points[i].map(|c| (c + 0.0).to_bits());
-    by_coord.sort_unstable_by_key(|&i| key(i));
-    let mut has_used_twin = vec![false; plc.points.len()];
-    let mut k = 0;
-    while k < by_coord.len() {
-        let mut j = k + 1;
-        while j < by_coord.len() && key(by_coord[j]) == key(by_coord[k]) {
-            j += 1;
-        }
-        let any_used = by_coord[k..j].iter().any(|&i| used[i]);
-        for &i in &by_coord[k..j] {
-            has_used_twin[i] = any_used && !used[i];
-        }
-        k = j;
-    }
-    unused.retain(|&i| !has_used_twin[i]);
-    for i in unused {
-        pr.push(format!(
-            "input point {} is not a vertex of the mesh",
-            i + base
-        ));
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::options::Options;
-
-    fn cube_with_center() -> Plc {
-        let mut pts: Vec<Point> = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
-            .collect();
-        pts.push([0.4, 0.45, 0.55]);
-        pts.push([0.9, 0.2, 0.3]);
-        Plc::from_points(pts, 0)
-    }
-
-    fn meshed(plc: &Plc) -> MeshOut {
-        crate::tetrahedralize(plc, &Options::default())
-            .unwrap()
-            .mesh
-    }
-
-    #[test]
-    fn a_delaunay_mesh_passes() {
-        let plc = cube_with_center();
-        check_mesh(&plc, &meshed(&plc)).unwrap();
-    }
-
-    #[test]
-    fn wrong_hull_faces_fail() {
-        let plc = cube_with_center();
-        let mut m = meshed(&plc);
-        assert!(!m.hull_faces.is_empty());
-        m.hull_faces[0].swap(1, 2);
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(e.contains("hull face 0"), "{e}");
-        m.hull_faces.pop();
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(e.contains("hull faces but has"), "{e}");
-    }
-
-    #[test]
-    fn an_inverted_tet_fails() {
-        let plc = cube_with_center();
-        let mut m = meshed(&plc);
-        m.tets[0].swap(0, 1);
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(e.contains("not positively oriented"), "{e}");
-    }
-
-    #[test]
-    fn a_missing_tet_fails() {
-        let plc = cube_with_center();
-        let mut m = meshed(&plc);
-        let all_used_before = m.tets.len();
-        m.tets.remove(all_used_before / 2);
-        m.neighbors.clear();
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(e.contains("boundary"), "{e}");
-    }
-
-    #[test]
-    fn a_non_delaunay_face_fails() {
-        // Two tets sharing a face whose opposite vertices see each other inside
-        // their circumspheres: a valid tiling of the hull, but not Delaunay.
-        let pts = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.3, 0.3, 0.05],
-            [0.3, 0.3, -0.05],
-        ];
-        let plc = Plc::from_points(pts.clone(), 0);
-        let orient = |t: [u32; 4]| {
-            let p = |v: u32| &pts[v as usize];
-            if orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) > 0.0 {
-                t
-            } else {
-                [t[1], t[0], t[2], t[3]]
-            }
-        };
-        let m = MeshOut {
-            points: pts.clone(),
-            tets: vec![orient([0, 1, 2, 3]), orient([0, 1, 2, 4])],
-            ..Default::default()
-        };
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(
-            e.contains("not locally Delaunay") || e.contains("not convex"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn an_unused_point_fails_but_a_duplicate_does_not() {
-        let mut plc = cube_with_center();
-        plc.points.push(plc.points[3]);
-        let m = meshed(&plc);
-        check_mesh(&plc, &m).unwrap();
-        let mut m2 = m.clone();
-        // Pretend point 9 was never inserted: drop every tet that uses it.
-        m2.tets.retain(|t| !t.contains(&9));
-        m2.neighbors.clear();
-        assert!(check_mesh(&plc, &m2).is_err());
-    }
-
-    #[test]
-    fn a_plc_point_inside_the_mesh_must_be_a_vertex() {
-        let cube = |extra: bool| {
-            let mut plc = cube_with_center();
-            plc.points.truncate(8);
-            if extra {
-                plc.points.push([0.4, 0.45, 0.55]);
-            }
-            let quads = [
-                [0, 2, 3, 1],
-                [4, 5, 7, 6],
-                [0, 1, 5, 4],
-                [2, 6, 7, 3],
-                [0, 4, 6, 2],
-                [1, 3, 7, 5],
-            ];
-            plc.facets = quads
-                .iter()
-                .map(|q| crate::plc::Facet {
-                    polygons: vec![q.to_vec()],
-                    ..Default::default()
-                })
-                .collect();
-            plc
-        };
-        let opts = Options {
-            plc: true,
-            ..Default::default()
-        };
-        let full = cube(true);
-        let m = crate::tetrahedralize(&full, &opts).unwrap().mesh;
-        check_mesh(&full, &m).unwrap();
-        // The cube meshed without its inner point, checked against the model with it.
-        let mut lost = crate::tetrahedralize(&cube(false), &opts).unwrap().mesh;
-        lost.points.push(full.points[8]);
-        let e = check_mesh(&full, &lost).unwrap_err().to_string();
-        assert!(e.contains("input point 8 lies in tet"), "{e}");
-    }
-
-    #[test]
-    fn a_shim_fails() {
-        // A square pyramid whose base is bent by 1e-4: the mesher's mesh passes, and the
-        // same domain with a flat tet of the four base corners beneath two others fails.
-        let mut plc = Plc::from_points(
-            vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [1.0, 1.0, 0.0],
-                [0.0, 1.0, -1e-4],
-                [0.5, 0.5, 1.0],
-            ],
-            0,
-        );
-        let polygons = [
-            vec![0, 1, 2, 3],
-            vec![0, 1, 4],
-            vec![1, 2, 4],
-            vec![2, 3, 4],
-            vec![3, 0, 4],
-        ];
-        plc.facets = polygons
-            .into_iter()
-            .map(|p| crate::plc::Facet {
-                polygons: vec![p],
-                ..Default::default()
-            })
-            .collect();
-        let opts = Options {
-            plc: true,
-            ..Default::default()
-        };
-        let mut m = crate::tetrahedralize(&plc, &opts).unwrap().mesh;
-        check_mesh(&plc, &m).unwrap();
-        m.tets = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 2, 3, 4]]
-            .into_iter()
-            .map(|mut t| {
-                let p = t.map(|v| m.points[v as usize]);
-                if orient3d(&p[0], &p[1], &p[2], &p[3]) < 0.0 {
-                    t.swap(0, 1);
-                }
-                t
-            })
-            .collect();
-        m.neighbors.clear();
-        // The base's triangles are now the lower pair, under the flat tet.
-        m.subfaces.retain(|(f, _)| f.contains(&4));
-        m.subfaces.extend([([0, 1, 3], 0), ([1, 2, 3], 0)]);
-        let e = check_mesh(&plc, &m).unwrap_err();
-        assert_eq!(e.total, 1, "{e:?}");
-        assert!(
-            e.listed[0].starts_with("tet 0 ") && e.listed[0].contains("is a shim"),
-            "{e:?}"
-        );
-    }
-
-    #[test]
-    fn problems_past_the_listed_ones_are_counted() {
-        let plc = cube_with_center();
-        let mut m = meshed(&plc);
-        m.tets = vec![[0, 0, 1, 2]; 30];
-        m.neighbors.clear();
-        let e = check_mesh(&plc, &m).unwrap_err();
-        assert_eq!((e.total, e.listed.len()), (30, 20), "{e:?}");
-        assert!(e.to_string().ends_with("\n... and 10 more problems"), "{e}");
-    }
-
-    #[test]
-    fn overlapping_tets_fail() {
-        let plc = cube_with_center();
-        let mut m = meshed(&plc);
-        let t = m.tets[0];
-        m.tets.push(t);
-        m.neighbors.clear();
-        let e = check_mesh(&plc, &m).unwrap_err().to_string();
-        assert!(e.contains("shared by"), "{e}");
-    }
-}
+mod tests;

@@ -2,6 +2,7 @@
 //! ([`batch`]), progress bars ([`progress`]) and the reports ([`summary`]).
 
 pub mod batch;
+pub mod certify;
 pub mod model;
 pub mod progress;
 pub mod summary;
@@ -29,11 +30,16 @@ pub struct Invocation {
     pub summary: Option<PathBuf>,
     /// The switch strings as given (for the comment closing a batch's files).
     pub switches: Vec<String>,
+    /// `--certify PREFIX`: certify that mesh against the one input instead of meshing.
+    pub certify: Option<PathBuf>,
 }
 
 /// Runs the command; `comment` closes the output files of a single input and `start`
 /// is when the command began. Returns the exit code, or the failure to print.
 pub fn run(inv: Invocation, comment: String, start: Instant) -> Result<i32, Failure> {
+    if let Some(prefix) = &inv.certify {
+        return certify::run(prefix, &inv.files[0], &inv.opts);
+    }
     if inv.files.len() > 1 {
         return batch::run_batch(inv);
     }
