@@ -11,7 +11,7 @@
 # (both write their .node/.ele/.face output), and prints the best and median wall times,
 # the peak resident set sizes and the ratios ours/TetGen as a markdown table for the
 # README. Targets: time ratio <= 0.5, memory ratio <= 1.0 (reported, not enforced).
-# Exits non-zero if a program fails or the two tet counts differ.
+# Exits non-zero if a program fails or the two sets of tets differ.
 #
 # Environment:
 #   TETCDT_BENCH_SEED  point seed (default 7)
@@ -112,6 +112,18 @@ done
 ele_count() { head -n 1 "$1" | awk '{ print $1 }'; }
 OURS_TETS=$(ele_count "$RUN/tetcdt/points.1.ele")
 TG_TETS=$(ele_count "$RUN/tetgen/points.1.ele")
+# The same tets, not only as many: both number the nodes as the input does.
+SAME_TETS=yes
+python3 - "$RUN/tetcdt/points.1.ele" "$RUN/tetgen/points.1.ele" <<'EOF' || SAME_TETS=no
+import sys
+import numpy as np
+def tets(path):
+    t = np.loadtxt(path, dtype=np.int64, comments="#", skiprows=1, usecols=(1, 2, 3, 4))
+    t.sort(axis=1)
+    return t[np.lexsort(t.T[::-1])]
+a, b = tets(sys.argv[1]), tets(sys.argv[2])
+sys.exit(0 if a.shape == b.shape and (a == b).all() else 1)
+EOF
 # The outputs are large (hundreds of MB at 1M points); keep only the logs.
 rm -f "$RUN"/*/points.1.*
 
@@ -137,7 +149,7 @@ print(f"| tets | {int(ours_tets):,} | {int(tg_tets):,} | | |")
 print()
 EOF
 
-if [[ "$OURS_TETS" != "$TG_TETS" ]]; then
-    echo "bench: FAIL: tet counts differ (tetcdt $OURS_TETS, TetGen $TG_TETS)" >&2
+if [[ "$OURS_TETS" != "$TG_TETS" || $SAME_TETS != yes ]]; then
+    echo "bench: FAIL: the tets differ (tetcdt $OURS_TETS, TetGen $TG_TETS)" >&2
     exit 1
 fi

@@ -8,7 +8,8 @@ usage: scripts/certify-vs-referee.py [--jobs N] [--keep DIR] [PATTERN...]
 Models: the corpus files the referee reads (.off .poly .smesh .mesh .node) that TetGen
 meshes with -pO0 (tetgen_p_O0.tsv), outside tetgen_stp/. Each mesh gets both verdicts;
 the table lists every model, and the disagreements are listed at the end. Exits 1 when
-a verdict could not be had (a crash, a timeout) or when the two disagree.
+a verdict could not be had (a crash, a timeout) or when the two disagree, except where
+a disagreement was looked into and the referee found wrong (KNOWN, with the reason).
 
 Environment: CORPUS (default ../shared/corpus), TETCDT (default target/release/tetcdt),
 TETCDT_TOOLS (the directory of validate_mesh.py, default ../shared/tools), TIMEOUT
@@ -29,6 +30,17 @@ TOOLS = os.environ.get("TETCDT_TOOLS", os.path.join(ROOT, "..", "shared", "tools
 TIMEOUT = int(os.environ.get("TIMEOUT", "600"))
 READABLE = (".off", ".poly", ".smesh", ".mesh", ".node")
 
+# Disagreements looked into, where the referee is wrong, and why. anchor_dense: a Steiner
+# point on the segment between two nearly coplanar facets that stay unmerged (more than
+# 0.1 degree apart) lies within the thick slab of the merged facet beside them (its
+# thickness is four times the facet's deviation from flat); the referee counts it on
+# that facet, so it takes a flat tet between the two facets for a shim, then leaves the
+# face beneath it out of the facet's cover. The point lies on no polygon of that facet.
+KNOWN = {
+    ("tetgentests_cgal/anchor_dense.off", "tetgen -pO0"): "referee: slab of a merged facet",
+    ("tetgentests_cgal/anchor_dense.off", "tetgen -p"): "referee: slab of a merged facet",
+}
+
 
 def run(cmd, cwd):
     try:
@@ -48,6 +60,8 @@ def verdicts(work, name, prefix):
     rc2, out2 = run([sys.executable, os.path.join(TOOLS, "validate_mesh.py"), name, prefix], work)
     ref = {0: True, 1: False}.get(rc2)
     last = out2.strip().splitlines()[-1] if out2.strip() else ""
+    if cert is None or ref is None:
+        return cert, ref, f"no verdict: certify exit {rc}, referee exit {rc2}"
     note = (first[0].strip() if first else "") + (" | " + last if ref is False else "")
     return cert, ref, note
 
@@ -109,11 +123,22 @@ def main(argv):
     print("|---|---|---|---|---|")
     for rel, label, cert, ref, note in table:
         print(f"| `{rel}` | {label} | {show[cert]} | {show[ref]} | {note.replace('|', '/')} |")
-    disagree = [r for r in table if r[2] is not None and r[3] is not None and r[2] != r[3]]
-    missing = [r for r in table if r[2] is None and r[4] != "mesher exit 1" and not r[4].startswith("mesher exit")]
+    disagree = [r for r in table if r[2] is not None and r[3] is not None and r[2] != r[3]
+                and (r[0], r[1]) not in KNOWN]
+    known = [r for r in table if r[2] is not None and r[3] is not None and r[2] != r[3]
+             and (r[0], r[1]) in KNOWN]
+    # A mesher may refuse a model or write an empty mesh (an open surface); a verdict
+    # that could not be had is a failure.
+    missing = [r for r in table if r[4].startswith("no verdict")]
+    for r in missing:
+        print(f"- `{r[0]}` ({r[1]}): {r[4]}")
     agree = sum(1 for r in table if r[2] is not None and r[2] == r[3])
     print()
-    print(f"{agree} meshes with the same verdict, {len(disagree)} disagreements.")
+    print(f"{agree} meshes with the same verdict, {len(known)} known disagreements, "
+          f"{len(disagree)} others.")
+    for r in known:
+        print(f"- known: `{r[0]}` ({r[1]}): --certify {show[r[2]]}, referee {show[r[3]]}: "
+              f"{KNOWN[(r[0], r[1])]}")
     for r in disagree:
         print(f"- `{r[0]}` ({r[1]}): --certify {show[r[2]]}, referee {show[r[3]]}: {r[4]}")
     return 1 if disagree or missing else 0

@@ -6,14 +6,12 @@ usage: fig9.py FIG9.CSV OUT.PNG
 Left panel: every size; right panel: up to 2,000 crossing tets (the paper's range). The
 y axis is scaled to the other three series: TetGen -L, far slower, is clipped at the top.
 Time in milliseconds against crossing tets, for our -C and -F and TetGen's -pcO0 (cavity)
-and -pcLO0 (flips). Uses matplotlib when it is installed, else draws the PNG itself (a
-plain raster with a small built-in font). Prints a summary: the least-squares line of
-each series, the -F/-C ratios, and how we compare with TetGen's counterparts.
+and -pcLO0 (flips), drawn with matplotlib (pip install matplotlib). Prints a summary: the
+least-squares line of each series, the -F/-C ratios, and how we compare with TetGen's
+counterparts. Exits 1 if any of our runs failed.
 """
 import csv
-import struct
 import sys
-import zlib
 
 SERIES = [
     ("ours -C", "cavity_secs", (31, 119, 180)),
@@ -94,9 +92,10 @@ def summary(rows, data):
     print(f"flip fallbacks to cavity: {fallbacks}")
     for f in failed:
         print(f"failed: {f}")
+    return failed
 
 
-def plot_matplotlib(data, out):
+def plot(data, out):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -121,131 +120,15 @@ def plot_matplotlib(data, out):
     fig.savefig(out, dpi=100)
 
 
-# A 3x5 font: each glyph is five rows of three bits.
-FONT = {
-    "0": "111101101101111", "1": "010110010010111", "2": "111001111100111",
-    "3": "111001111001111", "4": "101101111001001", "5": "111100111001111",
-    "6": "111100111101111", "7": "111001001010010", "8": "111101111101111",
-    "9": "111101111001111", ".": "000000000000010", "-": "000000111000000",
-    " ": "000000000000000", ",": "000000000010100", "(": "010100100100010",
-    ")": "010001001001010", "/": "001001010100100", ":": "000010000010000",
-    "A": "010101111101101", "C": "111100100100111", "D": "110101101101110",
-    "E": "111100111100111", "F": "111100111100100", "G": "111100101101111",
-    "H": "101101111101101", "I": "111010010010111", "K": "101101110101101",
-    "L": "100100100100111", "M": "101111111101101", "N": "110101101101101",
-    "O": "111101101101111", "P": "111101111100100", "R": "110101110101101",
-    "S": "111100111001111", "T": "111010010010010", "U": "101101101101111",
-    "W": "101101111111101", "X": "101101010101101", "Y": "101101010010010",
-    "Z": "111001010100111", "B": "110101110101110", "V": "101101101101010",
-}
-
-
-class Canvas:
-    def __init__(self, w, h):
-        self.w, self.h = w, h
-        self.px = bytearray(b"\xff" * (w * h * 3))
-
-    def set(self, x, y, c):
-        if 0 <= x < self.w and 0 <= y < self.h:
-            i = 3 * (y * self.w + x)
-            self.px[i:i + 3] = bytes(c)
-
-    def rect(self, x0, y0, x1, y1, c):
-        for y in range(min(y0, y1), max(y0, y1) + 1):
-            for x in range(min(x0, x1), max(x0, x1) + 1):
-                self.set(x, y, c)
-
-    def line(self, x0, y0, x1, y1, c):
-        n = max(abs(x1 - x0), abs(y1 - y0), 1)
-        for k in range(n + 1):
-            self.set(round(x0 + (x1 - x0) * k / n), round(y0 + (y1 - y0) * k / n), c)
-
-    def text(self, x, y, s, c=(0, 0, 0), scale=2):
-        for ch in s.upper():
-            g = FONT.get(ch, FONT[" "])
-            for r in range(5):
-                for q in range(3):
-                    if g[3 * r + q] == "1":
-                        self.rect(x + q * scale, y + r * scale,
-                                  x + q * scale + scale - 1, y + r * scale + scale - 1, c)
-            x += 4 * scale
-
-    def save(self, path):
-        raw = b"".join(b"\x00" + bytes(self.px[3 * self.w * y:3 * self.w * (y + 1)])
-                       for y in range(self.h))
-        def chunk(kind, body):
-            return (struct.pack(">I", len(body)) + kind + body
-                    + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF))
-        png = (b"\x89PNG\r\n\x1a\n"
-               + chunk(b"IHDR", struct.pack(">IIBBBBB", self.w, self.h, 8, 2, 0, 0, 0))
-               + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
-        open(path, "wb").write(png)
-
-
-def nice_ticks(hi, n=5):
-    if hi <= 0:
-        return [0]
-    raw = hi / n
-    mag = 10 ** len(str(int(raw))) / 10 if raw >= 1 else 10 ** -len(str(int(1 / raw)))
-    step = min((m * mag for m in (1, 2, 5, 10) if m * mag >= raw), default=raw)
-    return [k * step for k in range(int(hi / step) + 1)]
-
-
-def fmt(v):
-    return f"{v:.0f}" if v >= 10 or v == 0 else f"{v:.2g}"
-
-
-def panel(cv, data, x0, y0, w, h, limit, title):
-    pts_all = [p for name, _, _ in SERIES for p in data[name] if limit is None or p[0] <= limit]
-    if not pts_all:
-        return
-    xmax = max(p[0] for p in pts_all) * 1.05
-    # Scaled to ours and TetGen -C; TetGen -L is clipped at the top.
-    others = [p[1] for name, _, _ in SERIES[:3] for p in data[name]
-              if limit is None or p[0] <= limit] or [p[1] for p in pts_all]
-    ymax = max(others) * 1.3
-    def tx(x):
-        return round(x0 + x / xmax * w)
-    def ty(y):
-        return round(y0 + h - min(y, ymax) / ymax * h)
-    for t in nice_ticks(xmax):
-        cv.line(tx(t), y0, tx(t), y0 + h, (230, 230, 230))
-        cv.text(tx(t) - 8, y0 + h + 8, fmt(t))
-    for t in nice_ticks(ymax):
-        cv.line(x0, ty(t), x0 + w, ty(t), (230, 230, 230))
-        cv.text(x0 - 8 * len(fmt(t)) - 6, ty(t) - 5, fmt(t))
-    cv.line(x0, y0 + h, x0 + w, y0 + h, (0, 0, 0))
-    cv.line(x0, y0, x0, y0 + h, (0, 0, 0))
-    cv.text(x0, y0 - 22, title)
-    cv.text(x0 + w // 2 - 100, y0 + h + 28, "CROSSING TETS")
-    cv.text(x0 - 60, y0 - 40, "MS")
-    for k, (name, _, color) in enumerate(SERIES):
-        pts = [p for p in data[name] if limit is None or p[0] <= limit]
-        for a, b in zip(pts, pts[1:]):
-            cv.line(tx(a[0]), ty(a[1]), tx(b[0]), ty(b[1]), color)
-        for p in pts:
-            cv.rect(tx(p[0]) - 2, ty(p[1]) - 2, tx(p[0]) + 2, ty(p[1]) + 2, color)
-        cv.rect(x0 + 12, y0 + 10 + 16 * k, x0 + 24, y0 + 20 + 16 * k, color)
-        cv.text(x0 + 30, y0 + 10 + 16 * k, name)
-
-
-def plot_raster(data, out):
-    cv = Canvas(1200, 520)
-    panel(cv, data, 90, 60, 460, 380, None, "FIGURE 9: ALL SIZES (TETGEN -L CLIPPED)")
-    panel(cv, data, 690, 60, 460, 380, 2000, "UP TO 2000 CROSSING TETS")
-    cv.save(out)
-
-
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     rows, data = load(sys.argv[1])
-    summary(rows, data)
-    try:
-        plot_matplotlib(data, sys.argv[2])
-    except ImportError:
-        plot_raster(data, sys.argv[2])
+    failed = summary(rows, data)
+    plot(data, sys.argv[2])
     print(f"wrote {sys.argv[2]}")
+    # A run that failed makes the figure incomplete: the caller must know.
+    sys.exit(1 if failed else 0)
 
 
 if __name__ == "__main__":

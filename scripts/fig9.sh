@@ -106,3 +106,5 @@ for n in $SIZES; do
     echo "n=$n crossing=$crossing -C=${c_secs:-$c_status} -F=${f_secs:-$f_status} tetgen=$tc tetgen-L=$tl" >&2
 done
 python3 "$ROOT/scripts/fig9.py" "$CSV" "$OUT/fig9.png" | tee "$OUT/summary.txt"
+# fig9.py exits 1 when one of our runs failed: so does this script.
+exit "${PIPESTATUS[0]}"

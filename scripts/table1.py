@@ -371,6 +371,14 @@ def main():
                                         "status": r[which]["status"],
                                         "note": r[which]["note"],
                                         "figures": r[which]["record"]}) + "\n")
+    # Our own meshing failures (not refusals of invalid input, exit 3) make the table
+    # wrong: exit 1. TetGen's are only reported.
+    ours_failed = [f"{r['name']} ({w}): {r[w]['note']}" for r in results
+                   for w in ("ours", "ours_flip")
+                   if r[w]["status"] not in ("ok", "n/a", "fail 3")]
+    for f in ours_failed:
+        print(f"table1.py: failed: {f}", file=sys.stderr)
+    sys.exit(1 if ours_failed else 0)
 
 
 if __name__ == "__main__":

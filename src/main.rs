@@ -61,7 +61,7 @@ are the input points in input order, without those no tet uses (unless -J), then
 Steiner points.
 
 --certify PREFIX FILE certifies an existing mesh (PREFIX.node, PREFIX.ele, from any
-mesher) as a CDT of FILE (with -c: its convex hull kept; with -M: facets not merged)
+mesher) as a CDT of FILE (with -pc: its convex hull kept; with -pM: facets not merged)
 and exits 1 listing the problems if it is not one.
 
 Exit codes: 0 ok, 1 meshing failed (or --check found problems), 2 usage error,

@@ -196,7 +196,28 @@ fn check_validates_the_written_mesh() {
     write_points(&dir.path().join("p.node"), 30, 1);
     let (code, stdout, stderr) = run_in(dir.path(), &["--check", "p.node"]);
     assert_eq!(code, 0, "{stderr}");
-    assert!(stdout.contains("Mesh check passed."), "{stdout}");
+    // The figures are those of the files written, which --certify confirms.
+    let tets = data_lines(&dir.path().join("p.1.ele")).len() - 1;
+    assert!(
+        stdout.contains(&format!("Mesh check passed: {tets} tets, 0 Steiner points")),
+        "{stdout}"
+    );
+    let (code, stdout, stderr) = run_in(dir.path(), &["--certify", "p.1", "p.node"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains(&format!("{tets} tets")), "{stdout}");
+    // The same files, one tet short: the certifier the check runs rejects them.
+    let ele = dir.path().join("p.1.ele");
+    let mut rows = data_lines(&ele);
+    rows.pop();
+    rows[0][0] = (tets - 1).to_string();
+    let text: Vec<String> = rows.iter().map(|r| r.join(" ")).collect();
+    fs::write(&ele, text.join("\n") + "\n").unwrap();
+    let (code, _, stderr) = run_in(dir.path(), &["--certify", "p.1", "p.node"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("is not the Delaunay tetrahedralization"),
+        "{stderr}"
+    );
     let (code, stdout, stderr) = run_in(dir.path(), &["-Qz", "p.node", "--check"]);
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(stdout, "");

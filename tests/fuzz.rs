@@ -93,6 +93,11 @@ fn mesh_any(plc: &Plc) -> Result<Option<tetcdt::Meshed>, String> {
     match tetcdt::tetrahedralize(plc, &opts) {
         Ok(m) => {
             MESHED.fetch_add(1, Relaxed);
+            // Exit 0 means a valid mesh: certified here too, point sets included.
+            let copts = tetcdt::check::CertifyOptions::of(&opts);
+            if let Err(p) = tetcdt::check::check_mesh(plc, &m.mesh, &copts) {
+                return Err(format!("a mesh given as valid fails the certifier: {p}"));
+            }
             Ok(Some(m))
         }
         Err(e) => {

@@ -629,9 +629,13 @@ fn unused_points(plc: &Plc, node: &[u32], points: &[Point], tets: &[[u32; 4]], p
     }
 }
 
-/// `--check`: certifies the mesh as written (without the points no tet uses), then the
+/// `--check`: certifies the mesh (as written: without the points no tet uses), then the
 /// tables the mesher wrote beside it (neighbours, hull faces) against the tets.
-pub fn check_mesh(plc: &Plc, mesh: &MeshOut, opts: &CertifyOptions) -> Result<(), CheckFailure> {
+pub fn check_mesh(
+    plc: &Plc,
+    mesh: &MeshOut,
+    opts: &CertifyOptions,
+) -> Result<Certificate, CheckFailure> {
     let view = MeshView {
         points: &mesh.points,
         tets: &mesh.tets,
@@ -661,8 +665,9 @@ pub fn check_mesh(plc: &Plc, mesh: &MeshOut, opts: &CertifyOptions) -> Result<()
         };
         &plc_view
     };
-    certify_prepared(plc, prep.as_ref(), view, opts)?;
-    check_tables(mesh)
+    let cert = certify_prepared(plc, prep.as_ref(), view, opts)?;
+    check_tables(mesh)?;
+    Ok(cert)
 }
 
 /// The neighbour table and the hull faces the mesher lists, against the tets.

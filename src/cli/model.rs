@@ -231,10 +231,16 @@ pub fn run_model(
         say!(say, "");
         say!(say, "Checking the mesh...");
         let copts = tetcdt::check::CertifyOptions::of(opts);
-        if let Err(problems) = tetcdt::check::check_mesh(&plc, &meshed.mesh, &copts) {
-            return Err(check_failure(&problems));
-        }
-        say!(say, "Mesh check passed.");
+        let cert = tetcdt::check::check_mesh(&plc, written, &copts)
+            .map_err(|problems| check_failure(&problems))?;
+        say!(
+            say,
+            "Mesh check passed: {} tets, {} Steiner points, {} faces on facets, {} edges on segments.",
+            cert.tets,
+            cert.steiner_points,
+            cert.subfaces,
+            cert.subsegments
+        );
     }
     Ok(Done {
         points: written.points.len(),
