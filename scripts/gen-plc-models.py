@@ -26,7 +26,9 @@ It writes two kinds of files:
       that other facets fill, with markers of their own or the wall's;
    g. degenerate_tris.off, degenerate_tris_{obj,ply,ascii,binary}.*: one closed
       surface whose files add triangles with a repeated corner (a literal repeat, and two
-      corners at one point after welding), which the readers drop.
+      corners at one point after welding), which the readers drop;
+   h. flat_grid_{6,8}.poly: cubes of quads a little off their plane with points inside
+      (scripts/gen-flat-grids.py), which need no Steiner point.
 2. Copies of small corpus models (unmodified), with data/plc/LICENSES.md built from the
    corpus MANIFEST.tsv. Skipped, keeping the copies already present, when the corpus is
    not found ($CORPUS, --corpus DIR, or ../shared/corpus relative to the repository).
@@ -37,6 +39,7 @@ import os
 import random
 import shutil
 import struct
+import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -500,6 +503,17 @@ def degenerate_tris():
             f.write(b"\0\0")
 
 
+# ---------- h. nearly flat quad grids ----------
+
+def flat_grids():
+    # Cubes whose sides are grids of quads a little off their plane (merged into one facet
+    # per side), with points inside near them: TetGen meshes them with no Steiner point.
+    gen = os.path.join(os.path.dirname(os.path.abspath(__file__)), "gen-flat-grids.py")
+    for k, d, n, seed in ((6, "1e-12", 400, 1), (8, "1e-8", 600, 2)):
+        subprocess.run([sys.executable, gen, str(k), d, str(n), str(seed),
+                        os.path.join(OUT, f"flat_grid_{k}.poly")], check=True)
+
+
 # ---------- copies of corpus models ----------
 
 def find_corpus(argv):
@@ -547,7 +561,7 @@ def copy_corpus(corpus):
             "## Hand-made models",
             "",
             "Every other model file in this directory (`prism_*`, `fig4_*`, `cosph_*`, `gridbox_*`, `box_*`, "
-            "`ushape.poly`, `window*.poly`, `degenerate_tris*`) is written by `scripts/gen-plc-models.py` and is part of this project, under its "
+            "`ushape.poly`, `window*.poly`, `degenerate_tris*`, `flat_grid_*`) is written by `scripts/gen-plc-models.py` and is part of this project, under its "
             "license (MIT OR Apache-2.0).",
             "",
             "## Reference meshes",
@@ -578,6 +592,7 @@ def main(argv):
     window_wall()
     windows()
     degenerate_tris()
+    flat_grids()
     corpus = find_corpus(argv)
     if corpus:
         copy_corpus(corpus)

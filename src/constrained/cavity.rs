@@ -397,32 +397,90 @@ impl Seen {
 /// The mesh faces that triangulate the region when no tet crosses it: a flood over mesh
 /// faces with all vertices on the region, from its boundary edges inward (sides told
 /// apart in the facet's projection). `None` if they do not make up a triangulation of it.
+///
+/// Where the polygon is not flat, tets with all four vertices on it (shims) can lie in
+/// layers against it: the faces between a layer and the tets beside it then triangulate
+/// the polygon twice, once above the layer and once below. Either is a triangulation of
+/// the polygon; the faces above are tried first, then those below. The layer is left on
+/// the other side, where carving removes it if that side is outside the domain, and the
+/// shims' repairs see it otherwise.
 fn adopt(cdt: &mut Cdt, region: &Region, normal: [f64; 3]) -> Option<Vec<[VertexId; 3]>> {
+    let on_region = |v: &[VertexId]| v.iter().all(|x| region.verts.contains(x));
+    // A shim lies within the region's slab: four times its vertices' deviation from their
+    // mean plane (its vertices need not be the region's: the layer against the hull
+    // reaches the polygon's other vertices).
+    let height = |v: VertexId| crate::geom::dot(&cdt.dt.points[v as usize], &normal);
+    let hs: Vec<f64> = region.verts.iter().map(|&v| height(v)).collect();
+    let mean = hs.iter().sum::<f64>() / hs.len().max(1) as f64;
+    let dev = hs.iter().map(|h| (h - mean).abs()).fold(0.0, f64::max);
+    let slab = 4.0 * dev + f64::EPSILON * mean.abs();
+    let in_slab = |v: &[VertexId; 4]| {
+        v.iter()
+            .all(|&x| x != GHOST && (height(x) - mean).abs() <= slab)
+    };
+    // Each face with all vertices on the region, with whether the tets on its two sides
+    // (seen along the normal: above, below) are shims.
+    let mut faces: FxHashMap<[VertexId; 3], [bool; 2]> = FxHashMap::default();
+    let mut star = Vec::new();
+    let p = |v: VertexId| cdt.dt.points[v as usize];
+    for &v in &region.verts {
+        cdt.dt.star(v, &mut star);
+        for &t in &star {
+            let tv = cdt.dt.mesh.verts(t);
+            if cdt.is_ghost(t) {
+                continue;
+            }
+            let shim = in_slab(&tv);
+            for (i, fv) in FACE_VERTS.iter().enumerate() {
+                let f = [tv[fv[0]], tv[fv[1]], tv[fv[2]]];
+                if !on_region(&f) {
+                    continue;
+                }
+                // Which side of the face tet `t` lies on: the side of its fourth vertex,
+                // along the normal.
+                let n = crate::geom::cross(
+                    &crate::geom::sub(&p(f[1]), &p(f[0])),
+                    &crate::geom::sub(&p(f[2]), &p(f[0])),
+                );
+                let up = crate::geom::dot(&n, &normal)
+                    * orient3d(&p(f[0]), &p(f[1]), &p(f[2]), &p(tv[i]));
+                let side = usize::from(up < 0.0);
+                faces.entry(face_key(f)).or_insert([false; 2])[side] |= shim;
+            }
+        }
+    }
+    let shims = faces.values().any(|s| s[0] || s[1]);
+    let envelopes: &[usize] = if shims { &[0, 1] } else { &[0] };
+    for &keep in envelopes {
+        // A face is taken only if the tet on the `keep` side is no shim (so never one
+        // inside a layer).
+        let cand: FxHashSet<[VertexId; 3]> = faces
+            .iter()
+            .filter(|(_, s)| !s[keep])
+            .map(|(f, _)| *f)
+            .collect();
+        if let Some(found) = flood(cdt, region, normal, &cand) {
+            return Some(found);
+        }
+    }
+    None
+}
+
+/// The candidate faces `cand` that triangulate the region, flooded from its boundary edges
+/// inward, or `None` if they do not make up a triangulation of it.
+fn flood(
+    cdt: &Cdt,
+    region: &Region,
+    normal: [f64; 3],
+    cand: &FxHashSet<[VertexId; 3]>,
+) -> Option<Vec<[VertexId; 3]>> {
     let seen = Seen::along(normal);
     let o2 = |a: VertexId, b: VertexId, c: VertexId| {
         let p = |v: VertexId| &cdt.dt.points[v as usize];
         seen.orient(p(a), p(b), p(c))
     };
-    // Candidate faces around every region vertex.
-    let mut cand: FxHashSet<[VertexId; 3]> = FxHashSet::default();
-    let mut star = Vec::new();
-    for &v in &region.verts {
-        cdt.dt.star(v, &mut star);
-        for &t in &star {
-            let tv = cdt.dt.mesh.verts(t);
-            if tv.iter().all(|x| region.verts.contains(x)) {
-                return None; // a shim tet
-            }
-            for fv in FACE_VERTS {
-                let f = [tv[fv[0]], tv[fv[1]], tv[fv[2]]];
-                if f.iter().all(|x| region.verts.contains(x)) {
-                    cand.insert(face_key(f));
-                }
-            }
-        }
-    }
     let mut by_edge: FxHashMap<(VertexId, VertexId), Vec<[VertexId; 3]>> = FxHashMap::default();
-    for f in &cand {
+    for f in cand {
         for k in 0..3 {
             let (a, b) = (f[k], f[(k + 1) % 3]);
             by_edge.entry((a.min(b), a.max(b))).or_default().push(*f);
