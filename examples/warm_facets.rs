@@ -1,8 +1,8 @@
 //! Meshes one PLC again and again in one process and prints the fastest facet recovery,
 //! with `-C` or `-F`, or both in turns (`CF`, which also prints their ratio: turns keep
-//! the machine's slow spells from falling on one side only): the "in one process" times
-//! of the README, free of a fresh process's first-run costs. Also the loop to run under
-//! `valgrind --tool=callgrind`.
+//! the machine's slow spells from falling on one side only): facet recovery times free of
+//! a fresh process's first-run costs. Also the loop to run under `valgrind
+//! --tool=callgrind`.
 //!
 //! usage: cargo run --release --example warm_facets -- MODEL.poly C|F|CF [RUNS]
 
