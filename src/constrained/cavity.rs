@@ -14,6 +14,7 @@
 use super::cdt::{face_key, Cdt};
 use crate::delaunay::Delaunay;
 use crate::error::MeshError;
+use crate::geom::polygon::Projection;
 use crate::geom::predicates::adaptive_orient3d_calls;
 use crate::geom::{orient3d, Point};
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS as EDGES, FACE_VERTS, GHOST};
@@ -353,45 +354,18 @@ fn replace_cavity(
     }))
 }
 
-/// Orientations of points seen along a facet's normal: in the plane of the two other
-/// axes than its largest component.
-struct Seen {
-    u: usize,
-    w: usize,
-}
-
-impl Seen {
-    fn along(normal: [f64; 3]) -> Self {
-        let axis = (0..3)
-            .max_by(|&i, &j| normal[i].abs().total_cmp(&normal[j].abs()))
-            .unwrap_or(2);
-        Seen {
-            u: (axis + 1) % 3,
-            w: (axis + 2) % 3,
-        }
-    }
-
-    /// The exact orientation of `a`, `b`, `c` as seen.
-    fn orient(&self, a: &Point, b: &Point, c: &Point) -> f64 {
-        let co = |q: &Point| robust::Coord {
-            x: q[self.u],
-            y: q[self.w],
-        };
-        robust::orient2d(co(a), co(b), co(c))
-    }
-
-    /// Is `q` strictly inside one of the triangles `tris` (of the mesh's `points`)?
-    fn inside_any(&self, points: &[Point], tris: &[[VertexId; 3]], q: &Point) -> bool {
-        tris.iter().any(|t| {
-            let [x, y, z] = t.map(|v| &points[v as usize]);
-            let s = [
-                self.orient(x, y, q),
-                self.orient(y, z, q),
-                self.orient(z, x, q),
-            ];
-            s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
-        })
-    }
+/// Is `q` strictly inside one of the triangles `tris` (of the mesh's `points`) in the
+/// projection `seen`?
+fn inside_any(seen: &Projection, points: &[Point], tris: &[[VertexId; 3]], q: &Point) -> bool {
+    tris.iter().any(|t| {
+        let [x, y, z] = t.map(|v| &points[v as usize]);
+        let s = [
+            seen.orient(x, y, q),
+            seen.orient(y, z, q),
+            seen.orient(z, x, q),
+        ];
+        s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0)
+    })
 }
 
 /// The mesh faces that triangulate the region when no tet crosses it: a flood over mesh
@@ -474,7 +448,7 @@ fn flood(
     normal: [f64; 3],
     cand: &FxHashSet<[VertexId; 3]>,
 ) -> Option<Vec<[VertexId; 3]>> {
-    let seen = Seen::along(normal);
+    let seen = Projection::along(&normal);
     let o2 = |a: VertexId, b: VertexId, c: VertexId| {
         let p = |v: VertexId| &cdt.dt.points[v as usize];
         seen.orient(p(a), p(b), p(c))
@@ -1018,7 +992,7 @@ fn surface_neighbor(
 fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetId> {
     let mesh = &cdt.dt.mesh;
     let p = |v: VertexId| cdt.dt.points[v as usize];
-    let seen = Seen::along(normal);
+    let seen = Projection::along(&normal);
     let keys: FxHashSet<[VertexId; 3]> = region.tris.iter().map(|t| face_key(*t)).collect();
     let mut verts: Vec<VertexId> = region.verts.iter().copied().collect();
     verts.sort_unstable();
@@ -1037,7 +1011,7 @@ fn other_triangulation(cdt: &Cdt, region: &Region, normal: [f64; 3]) -> Vec<TetI
                     && !keys.contains(&face_key(f))
                 {
                     let c = [0, 1, 2].map(|k| (p(f[0])[k] + p(f[1])[k] + p(f[2])[k]) / 3.0);
-                    if seen.inside_any(&cdt.dt.points, &region.tris, &c) {
+                    if inside_any(&seen, &cdt.dt.points, &region.tris, &c) {
                         out.push(t);
                         out.push(n);
                     }
@@ -1389,7 +1363,7 @@ pub(crate) fn steiner_point(
             / nn;
         let q: Point = std::array::from_fn(|k| cc[k] - off * normal[k]);
         // Inside a region triangle, seen along the normal?
-        if Seen::along(normal).inside_any(&cdt.dt.points, tris, &q) {
+        if inside_any(&Projection::along(&normal), &cdt.dt.points, tris, &q) {
             return q;
         }
     }
