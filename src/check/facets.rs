@@ -387,7 +387,7 @@ fn facet_geometry<'a>(f: &'a MergedFacet, node: &[u32], points: &[Point], diag: 
         })
         .collect();
     let bbox = slab_box(&verts, points, tol);
-    let hole = hole_rings(&rings, &f.holes, points, &proj);
+    let hole = crate::geom::polygon::hole_rings(points, &rings, &f.holes, &proj);
     let ccw = rings
         .iter()
         .map(|r| ring_is_ccw(r, &proj, points))
@@ -419,28 +419,6 @@ fn slab_box(verts: &[u32], points: &[Point], tol: f64) -> Aabb {
         }
     }
     bbox
-}
-
-/// Which rings bound holes: for each hole point, the smallest ring around it.
-fn hole_rings(
-    rings: &[Vec<u32>],
-    holes: &[Point],
-    points: &[Point],
-    proj: &Projection,
-) -> Vec<bool> {
-    let mut hole = vec![false; rings.len()];
-    for h in holes {
-        let area = |r: &Vec<u32>| norm(&crate::geom::polygon::newell_normal(points, r));
-        let smallest = rings
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| proj.locate_in_ring(points, r, h) == RingSide::Inside)
-            .min_by(|a, b| area(a.1).total_cmp(&area(b.1)));
-        if let Some((k, _)) = smallest {
-            hole[k] = true;
-        }
-    }
-    hole
 }
 
 /// Whether a ring turns counterclockwise in the projection: the exact orientation at its

@@ -588,12 +588,7 @@ fn points_outside(
             ));
         }
     }
-    let mut used = vec![false; points.len()];
-    for t in tets {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
+    let used = used_nodes(points.len(), tets);
     let mut reported = 0;
     for (i, q) in plc.points.iter().enumerate() {
         let in_mesh = node[i] != u32::MAX && used[node[i] as usize];
@@ -611,14 +606,18 @@ fn points_outside(
     }
 }
 
+/// Which of `n` nodes some tet uses.
+fn used_nodes(n: usize, tets: &[[u32; 4]]) -> Vec<bool> {
+    let mut used = vec![false; n];
+    for &v in tets.iter().flatten() {
+        used[v as usize] = true;
+    }
+    used
+}
+
 /// Point sets: every input point is a node of some tet.
 fn unused_points(plc: &Plc, node: &[u32], points: &[Point], tets: &[[u32; 4]], pr: &mut Problems) {
-    let mut used = vec![false; points.len()];
-    for t in tets {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
+    let used = used_nodes(points.len(), tets);
     for (i, &x) in node.iter().enumerate() {
         if x == u32::MAX || !used[x as usize] {
             pr.push(format!(

@@ -4,18 +4,11 @@
 
 use crate::Failure;
 use anyhow::anyhow;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use tetcdt::check::{certify, CertifyError, CertifyOptions, MeshView};
 use tetcdt::error::{EXIT_MESH_FAILED, EXIT_OK};
+use tetcdt::io::write::{output_path, FileKind};
 use tetcdt::options::Options;
-
-/// `PREFIX.ext`.
-fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
-    let mut s = prefix.as_os_str().to_owned();
-    s.push(".");
-    s.push(ext);
-    PathBuf::from(s)
-}
 
 /// Certifies the mesh `prefix` against `input`; prints the verdict (unless quiet).
 pub fn run(prefix: &Path, input: &Path, opts: &Options) -> Result<i32, Failure> {
@@ -26,9 +19,10 @@ pub fn run(prefix: &Path, input: &Path, opts: &Options) -> Result<i32, Failure> 
     } else {
         plc
     };
-    let nodes = tetcdt::io::node::read(&with_ext(prefix, "node")).map_err(tetcdt::Error::from)?;
+    let nodes = tetcdt::io::node::read(&output_path(prefix, FileKind::Node))
+        .map_err(tetcdt::Error::from)?;
     let tets = tetcdt::io::ele::read(
-        &with_ext(prefix, "ele"),
+        &output_path(prefix, FileKind::Ele),
         nodes.first_index,
         nodes.points.len(),
     )

@@ -142,6 +142,29 @@ impl Projection {
     }
 }
 
+/// Which of `rings` (one facet's polygons, seen in `proj`) bound holes: for each hole
+/// point, the smallest ring (by area) that holds it strictly inside.
+pub fn hole_rings(
+    points: &[Point],
+    rings: &[Vec<u32>],
+    holes: &[Point],
+    proj: &Projection,
+) -> Vec<bool> {
+    let mut hole = vec![false; rings.len()];
+    let area = |r: &Vec<u32>| super::norm(&newell_normal(points, r));
+    for h in holes {
+        let smallest = rings
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.len() >= 3 && proj.locate_in_ring(points, r, h) == RingSide::Inside)
+            .min_by(|a, b| area(a.1).total_cmp(&area(b.1)));
+        if let Some((k, _)) = smallest {
+            hole[k] = true;
+        }
+    }
+    hole
+}
+
 /// Where a point lies relative to a polygon in projection.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RingSide {

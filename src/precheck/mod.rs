@@ -364,31 +364,25 @@ fn unflat(points: &[[f64; 3]], ring: &[u32]) -> Option<(u32, f64, f64)> {
 /// point, the smallest ring of its facet around it. Such a polygon covers no area, so
 /// another facet may fill it (a window in a wall, with a marker of its own).
 fn hole_rings(plc: &Plc, rep: &[u32]) -> rustc_hash::FxHashSet<(usize, usize)> {
-    use crate::geom::polygon::{newell_normal, Projection, RingSide};
+    use crate::geom::polygon::{newell_normal, Projection};
     let mut out = rustc_hash::FxHashSet::default();
     for (fi, f) in plc.facets.iter().enumerate() {
         if f.holes.is_empty() {
             continue;
         }
-        let rings: Vec<(usize, Vec<u32>)> = f
-            .polygons
+        let rings: Vec<Vec<u32>> = f.polygons.iter().map(|p| clean_ring(p, rep)).collect();
+        // Seen along the largest ring's normal, as the facet is prepared for meshing.
+        let Some(normal) = rings
             .iter()
-            .enumerate()
-            .map(|(pi, p)| (pi, clean_ring(p, rep)))
-            .filter(|(_, r)| r.len() >= 3)
-            .collect();
-        for h in &f.holes {
-            let around = rings.iter().filter_map(|(pi, r)| {
-                let n = newell_normal(&plc.points, r);
-                let proj = Projection::along(&n);
-                let inside = proj.locate_in_ring(&plc.points, r, h) == RingSide::Inside;
-                let area = crate::geom::norm(&n);
-                inside.then_some((area, *pi))
-            });
-            if let Some((_, pi)) = around.min_by(|a, b| a.0.total_cmp(&b.0)) {
-                out.insert((fi, pi));
-            }
-        }
+            .filter(|r| r.len() >= 3)
+            .map(|r| newell_normal(&plc.points, r))
+            .max_by(|a, b| crate::geom::norm(a).total_cmp(&crate::geom::norm(b)))
+        else {
+            continue;
+        };
+        let proj = Projection::along(&normal);
+        let hole = crate::geom::polygon::hole_rings(&plc.points, &rings, &f.holes, &proj);
+        out.extend((0..rings.len()).filter(|&pi| hole[pi]).map(|pi| (fi, pi)));
     }
     out
 }
