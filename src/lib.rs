@@ -4,6 +4,22 @@
 //! Data flows one way: [`io`] reads a [`plc::Plc`], [`delaunay`] builds the canonical
 //! Delaunay tetrahedralization in a [`mesh::Mesh`], and [`io::write`] writes the
 //! resulting [`output::MeshOut`]. [`check`] validates a mesh independently.
+//!
+//! [`live::Cdt`] keeps a PLC's CDT live: vertices go in one at a time, on segments and
+//! facets or anywhere inside, each insertion leaving a CDT that [`live::Cdt::certify`]
+//! checks (see `examples/incremental.rs`):
+//!
+//! ```
+//! use tetcdt::live::Cdt;
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/examples/cube.poly");
+//! let plc = tetcdt::io::read_plc(&path).unwrap();
+//! let mut cdt = Cdt::build(&plc, &Default::default()).unwrap();
+//! let on_edge = cdt.insert_vertex([0.5, 0.0, 0.0]).unwrap();
+//! assert!(on_edge.new);
+//! cdt.certify().unwrap();
+//! let mesh = cdt.mesh().unwrap();
+//! assert_eq!(mesh.points.len(), 9);
+//! ```
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -14,6 +30,7 @@ pub mod delaunay;
 pub mod error;
 pub mod geom;
 pub mod io;
+pub mod live;
 pub mod mesh;
 pub mod options;
 pub mod output;

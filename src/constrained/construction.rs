@@ -57,7 +57,7 @@ const LENS_PIECE: f64 = 0.9;
 const MAX_LENS_PARTS: usize = 64;
 
 /// A finished CDT, before carving and output.
-pub(super) struct Built {
+pub(crate) struct Built {
     pub cdt: Cdt,
     /// The subsegments with their markers.
     pub seg_markers: FxHashMap<(VertexId, VertexId), i32>,
@@ -77,6 +77,19 @@ pub(super) struct Built {
 }
 
 impl Built {
+    /// CDT `cdt` with subsegments `seg_markers`, nothing known of its flat tets.
+    pub fn of(cdt: Cdt, seg_markers: FxHashMap<(VertexId, VertexId), i32>) -> Self {
+        Built {
+            cdt,
+            seg_markers,
+            carved: None,
+            flat_left: slivers::OnFacets::default(),
+            retry_points: Vec::new(),
+            first_point_covers: false,
+            covering: 0,
+        }
+    }
+
     /// How far it is from a mesh without tets on facets: the fewer the better.
     pub fn tets_on_facets(&self) -> usize {
         self.flat_left.tets + self.covering

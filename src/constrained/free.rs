@@ -16,7 +16,7 @@ use crate::mesh::{FaceRef, TetId, VertexId, VertexLists, FACE_VERTS};
 const MAX_FLIPS: usize = 20_000;
 
 /// The vertices joined to each vertex by a subsegment: what [`insert_point`] checks.
-pub(super) fn subsegment_ends(cdt: &Cdt) -> VertexLists<VertexId> {
+pub(crate) fn subsegment_ends(cdt: &Cdt) -> VertexLists<VertexId> {
     let ends = cdt.subsegs.keys().flat_map(|&(a, b)| [(a, b), (b, a)]);
     VertexLists::new(cdt.dt.points.len(), ends)
 }
@@ -60,7 +60,7 @@ pub(super) fn insert_free(
 }
 
 /// What [`insert_point`] did.
-pub(super) enum Inserted {
+pub(crate) enum Inserted {
     /// The point is in as `vertex`; [`take_back`] undoes it while nothing else changed.
     Yes {
         vertex: VertexId,
@@ -83,7 +83,7 @@ pub(super) enum Inserted {
 /// the CDT as it was, if the flips cannot get there or a subsegment (`at`, from
 /// [`subsegment_ends`]) would be lost. `wrapped_asked`: whether a refusal should name the
 /// subface in the way (a search, wasted where nobody asks).
-pub(super) fn insert_point(
+pub(crate) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
     pert: u32,
@@ -121,6 +121,19 @@ pub(super) fn insert_point(
             });
         }
     };
+    settle(cdt, w, (vertex, first, last), at, wrapped_asked)
+}
+
+/// After vertex `vertex` (at `w`) went in by change `first` (point location started at
+/// `last` before), flips the faces that are not locally Delaunay; the point is in if
+/// that settles and no subsegment (`at`) is lost, else it is taken back.
+pub(crate) fn settle(
+    cdt: &mut Cdt,
+    w: Point,
+    (vertex, first, last): (VertexId, Change, TetId),
+    at: &VertexLists<VertexId>,
+    wrapped_asked: bool,
+) -> Result<Inserted, MeshError> {
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
     let (lost, wrapped) = match settled {
@@ -150,7 +163,7 @@ pub(super) fn insert_point(
 }
 
 /// Takes back a point that [`insert_point`] put in, if nothing has changed since.
-pub(super) fn take_back(cdt: &mut Cdt, inserted: Inserted) {
+pub(crate) fn take_back(cdt: &mut Cdt, inserted: Inserted) {
     if let Inserted::Yes {
         vertex,
         changes,

@@ -11,12 +11,12 @@
 mod bistellar;
 pub mod cavity;
 pub mod cdt;
-mod construction;
+pub(crate) mod construction;
 pub mod enclosure;
 pub mod facet2d;
 pub mod flip;
 mod flip_queue;
-mod free;
+pub(crate) mod free;
 mod in_place;
 pub mod segments;
 mod slivers;
@@ -265,6 +265,45 @@ pub fn mesh_plc_with_progress(
     opts: &PlcOptions,
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
+    let Constructed {
+        built,
+        split,
+        base,
+        mut stats,
+        warnings,
+    } = construct(plc, opts, progress)?;
+    let prep = split.as_ref().unwrap_or(&base);
+    let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
+    Ok(PlcMesh {
+        mesh,
+        stats,
+        warnings,
+        prepared: base,
+    })
+}
+
+/// A finished CDT of a PLC before carving: what [`mesh_plc`] carves, and what
+/// [`crate::live::Cdt`] keeps to insert into.
+pub(crate) struct Constructed {
+    /// The CDT.
+    pub built: Box<Built>,
+    /// The PLC as meshed when some merged groups were kept apart (else `base`): its facet
+    /// indices are the subfaces'.
+    pub split: Option<PreparedPlc>,
+    /// The PLC as prepared, which the certifier judges against.
+    pub base: PreparedPlc,
+    /// Figures.
+    pub stats: PlcStats,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
+/// The CDT of `plc`, not yet carved.
+pub(crate) fn construct(
+    plc: &Plc,
+    opts: &PlcOptions,
+    progress: Progress<'_>,
+) -> Result<Constructed, Error> {
     progress(Stage::Delaunay);
     let ((base, all_merged), first_dt) = prepare_beside_delaunay(plc, opts)?;
     let merged = all_merged.as_ref().unwrap_or(&base);
@@ -490,7 +529,6 @@ pub fn mesh_plc_with_progress(
             }
         }
     };
-    let prep = split.as_ref().unwrap_or(&base);
     let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
     stats.facet_steiner_points += facet_points.len() - free;
     stats.free_steiner_points += free;
@@ -501,12 +539,12 @@ pub fn mesh_plc_with_progress(
         let facet = facet_name(plc, &merged.facets[f as usize]);
         warnings.push(flat_tets_warning(left, &facet, stats.free_searches_cut > 0));
     }
-    let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
-    Ok(PlcMesh {
-        mesh,
+    Ok(Constructed {
+        built,
+        split,
+        base,
         stats,
         warnings,
-        prepared: base,
     })
 }
 
@@ -960,6 +998,19 @@ fn facet_name(plc: &Plc, f: &prepare::MergedFacet) -> String {
     } else {
         format!("{}", first + plc.first_index)
     }
+}
+
+/// Carves a copy of CDT `cdt` (whose subsegments are `seg_markers`) and puts it in
+/// output form.
+pub(crate) fn carve_copy(
+    plc: &Plc,
+    prep: &PreparedPlc,
+    cdt: &Cdt,
+    opts: &PlcOptions,
+    stats: &mut PlcStats,
+) -> Result<MeshOut, Error> {
+    let built = Built::of(cdt.clone(), cdt.subsegs.clone());
+    finish(plc, prep, built, opts, stats, &crate::progress::no_progress)
 }
 
 /// Carves the mesh and puts it in output form.

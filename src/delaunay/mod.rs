@@ -55,7 +55,7 @@ pub struct Delaunay {
 
 /// What [`Delaunay::blocked_cavity`] found.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
-enum Cavity {
+pub(crate) enum Cavity {
     /// The point coincides with a vertex.
     OnVertex,
     /// The cavity wraps around a blocked face: filling it would break the mesh.
@@ -442,6 +442,17 @@ impl Delaunay {
         }
     }
 
+    /// Widens the box of the static filter to cover Steiner point `p`.
+    pub(crate) fn widen_box(&mut self, p: &Point) {
+        let [lo, hi] = self.bbox;
+        if (0..3).any(|k| !(lo[k] <= p[k] && p[k] <= hi[k])) {
+            self.set_bbox([
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            ]);
+        }
+    }
+
     /// Finds the cavity of vertex `pv` walled in by the `blocked` faces (in `conflict`
     /// and `boundary`), without changing the mesh.
     fn blocked_cavity(
@@ -450,31 +461,40 @@ impl Delaunay {
         blocked: impl Fn([VertexId; 4], usize) -> bool,
     ) -> Result<Cavity, MeshError> {
         let p = *self.pt(pv);
-        let [lo, hi] = self.bbox;
-        if (0..3).any(|k| !(lo[k] <= p[k] && p[k] <= hi[k])) {
-            // A Steiner point outside the box: the static bounds must cover it.
-            self.set_bbox([
-                std::array::from_fn(|k| lo[k].min(p[k])),
-                std::array::from_fn(|k| hi[k].max(p[k])),
-            ]);
-        }
+        self.widen_box(&p);
         let start = match self.locate(&p) {
             Location::Vertex(_) => return Ok(Cavity::OnVertex),
             Location::Inside(t) | Location::Outside(t) => t,
         };
+        if !self.in_conflict(start, &p, pv) {
+            return Err(MeshError::Internal(format!(
+                "point {pv} lies in tet {start} but not in its circumsphere"
+            )));
+        }
+        Ok(self.grow_cavity(pv, &[start], blocked))
+    }
+
+    /// Grows the cavity of vertex `pv` from the tets `seeds` (taken whole), walled in by
+    /// the `blocked` faces, into `conflict` and `boundary`, without changing the mesh.
+    pub(crate) fn grow_cavity(
+        &mut self,
+        pv: VertexId,
+        seeds: &[TetId],
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Cavity {
+        let p = *self.pt(pv);
         // The constrained stages add tets behind this struct's back.
         if self.mark.len() < self.mesh.num_slots() {
             self.mark.resize(self.mesh.num_slots(), 0);
         }
         self.conflict.clear();
         self.boundary.clear();
-        if !self.in_conflict(start, &p, pv) {
-            return Err(MeshError::Internal(format!(
-                "point {pv} lies in tet {start} but not in its circumsphere"
-            )));
+        for &t in seeds {
+            if self.mark[t as usize] != IN_CONFLICT {
+                self.mark[t as usize] = IN_CONFLICT;
+                self.conflict.push(t);
+            }
         }
-        self.mark[start as usize] = IN_CONFLICT;
-        self.conflict.push(start);
         let mut walled = false;
         let mut wraps = false;
         let mut k = 0;
@@ -525,9 +545,93 @@ impl Delaunay {
                     .any(|b| self.mark[b.outside.tet() as usize] == IN_CONFLICT))
         {
             self.abandon_cavity();
-            return Ok(Cavity::Wraps);
+            return Cavity::Wraps;
         }
-        Ok(Cavity::Ready)
+        Cavity::Ready
+    }
+
+    /// Shrinks a grown cavity of vertex `pv` until it is seen whole from the vertex
+    /// (every boundary face makes a positive tet with it), as a cavity in a constrained
+    /// tetrahedralization must be: a tet with a boundary face the vertex does not see
+    /// strictly leaves, with the tets it alone connected to `seeds`, and the boundary is
+    /// made again. False, with the marks cleared, if a seed would have to leave; the
+    /// faces made by filling are then not all locally Delaunay, and flips settle them.
+    pub(crate) fn shrink_to_star(
+        &mut self,
+        pv: VertexId,
+        seeds: &[TetId],
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> bool {
+        // Every tet marked outside during growth is the outside of a boundary face.
+        for i in 0..self.boundary.len() {
+            let n = self.boundary[i].outside.tet() as usize;
+            if self.mark[n] == OUTSIDE {
+                self.mark[n] = 0;
+            }
+        }
+        loop {
+            let bad: Vec<TetId> = self
+                .boundary
+                .iter()
+                .filter(|b| b.v[3] != GHOST && !b.v.contains(&GHOST) && self.orientation(b.v) <= 0)
+                .map(|b| self.mesh.adj(b.outside).tet())
+                .collect();
+            if bad.is_empty() {
+                return true;
+            }
+            if bad.iter().any(|t| seeds.contains(t)) {
+                self.abandon_cavity();
+                return false;
+            }
+            for &t in &bad {
+                self.mark[t as usize] = 0;
+            }
+            // What stays is what the seeds still reach through faces that are not walls.
+            let kept: Vec<TetId> = std::mem::take(&mut self.conflict);
+            for &t in &kept {
+                if self.mark[t as usize] == IN_CONFLICT {
+                    self.mark[t as usize] = OUTSIDE;
+                }
+            }
+            for &t in seeds {
+                self.mark[t as usize] = IN_CONFLICT;
+                self.conflict.push(t);
+            }
+            let mut k = 0;
+            while k < self.conflict.len() {
+                let t = self.conflict[k];
+                k += 1;
+                let tet = *self.mesh.tet(t);
+                for (f, n) in tet.adj.iter().enumerate() {
+                    let n = n.tet() as usize;
+                    if self.mark[n] == OUTSIDE && !blocked(tet.v, f) {
+                        self.mark[n] = IN_CONFLICT;
+                        self.conflict.push(n as TetId);
+                    }
+                }
+            }
+            for &t in &kept {
+                if self.mark[t as usize] == OUTSIDE {
+                    self.mark[t as usize] = 0;
+                }
+            }
+            self.boundary.clear();
+            for i in 0..self.conflict.len() {
+                let t = self.conflict[i];
+                let tet = *self.mesh.tet(t);
+                for (f, &outside) in tet.adj.iter().enumerate() {
+                    if blocked(tet.v, f) || self.mark[outside.tet() as usize] != IN_CONFLICT {
+                        let mut v = tet.v;
+                        v[f] = pv;
+                        self.boundary.push(NewTet {
+                            v,
+                            face: f,
+                            outside,
+                        });
+                    }
+                }
+            }
+        }
     }
 
     /// Clears the marks of a cavity that will not be filled.

@@ -127,6 +127,12 @@ impl Delaunay {
                 _ => Ok(Walled::Refused),
             };
         }
+        self.fill_recorded(v)
+    }
+
+    /// Fills the ready cavity of vertex `v`, recording the change for
+    /// [`Delaunay::undo`].
+    fn fill_recorded(&mut self, v: VertexId) -> Result<Walled, MeshError> {
         // What filling overwrites: the cavity's tets, whose slots the new tets reuse.
         let old: Vec<(TetId, Tet)> = self
             .conflict
@@ -142,6 +148,60 @@ impl Delaunay {
             change: Change { old, new: created },
             last,
         })
+    }
+
+    /// The tets of the cavity that point `p` would have walled in by the `blocked` faces
+    /// (as far as it grew before a wall stopped it), without changing the mesh; empty
+    /// if `p` coincides with a vertex. `pert` is its perturbation index, as for
+    /// [`Delaunay::insert_walled`].
+    pub fn walled_conflict(
+        &mut self,
+        p: Point,
+        pert: u32,
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<Vec<TetId>, MeshError> {
+        let v = self.push_point(p, pert);
+        let found = self.blocked_cavity(v, &blocked);
+        if matches!(found, Ok(super::Cavity::Ready)) {
+            self.abandon_cavity();
+        }
+        self.points.pop();
+        self.orig.pop();
+        Ok(match found? {
+            super::Cavity::OnVertex => Vec::new(),
+            _ => self.conflict.clone(),
+        })
+    }
+
+    /// Inserts a Steiner point that splits a constraint: its cavity is the tets `seeds`
+    /// (those around the split edge, or the two on the split face, which hold the point on
+    /// their boundary) grown through the faces that are not `blocked`, and refused, with
+    /// nothing changed, if it wraps around a blocked face, pinches, or is not seen whole
+    /// from the point. The faces through the split constraint must not be `blocked`.
+    pub fn insert_seeded(
+        &mut self,
+        p: Point,
+        pert: u32,
+        seeds: &[TetId],
+        blocked: impl Fn([VertexId; 4], usize) -> bool,
+    ) -> Result<Walled, MeshError> {
+        if !p.iter().all(|c| c.is_finite()) || seeds.is_empty() {
+            return Ok(Walled::Refused);
+        }
+        self.widen_box(&p);
+        let v = self.push_point(p, pert);
+        let grown = self.grow_cavity(v, seeds, &blocked);
+        let ready =
+            matches!(grown, super::Cavity::Ready) && self.shrink_to_star(v, seeds, &blocked);
+        if !(ready && self.boundary_is_a_sphere() && self.fill_is_positive()) {
+            if ready {
+                self.abandon_cavity();
+            }
+            self.points.pop();
+            self.orig.pop();
+            return Ok(Walled::Refused);
+        }
+        self.fill_recorded(v)
     }
 
     /// After [`Delaunay::insert_walled`] refused point `p`, a blocked face that its cavity

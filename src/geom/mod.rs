@@ -1,6 +1,7 @@
 //! Geometry: exact predicates with symbolic perturbation, and the Hilbert/BRIO ordering.
 
 pub mod bvh;
+pub mod encroach;
 pub mod expansion;
 pub mod fixed;
 pub mod hilbert;

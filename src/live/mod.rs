@@ -1,0 +1,267 @@
+//! A live constrained Delaunay tetrahedralization: built once from a PLC, then changed
+//! in place, one vertex at a time, each insertion leaving a CDT of the PLC with its
+//! Steiner points (every face that is no subface locally Delaunay under the
+//! perturbation, every constraint a union of subsegments and subfaces).
+//!
+//! See the crate docs for an example, and `examples/incremental.rs`.
+//!
+//! [`Cdt::insert_vertex`] places a point by where it lands:
+//! - on a vertex: nothing changes;
+//! - exactly on a subsegment, or exactly on a subface: the constraint is split there,
+//!   its pieces keeping its marker and facet (`split.rs`);
+//! - elsewhere: a cavity walled in by the subfaces, then flips to local Delaunayhood.
+//!
+//! A point inside the diametral ball of a subsegment of its cavity encroaches upon it:
+//! the subsegment is split first (at its middle, or on a power-of-two shell around an
+//! input vertex), and the point tried again. A point whose walled cavity would remove a
+//! subsegment, or wrap around a subface, gets that constraint split first too. The
+//! splits are queue-driven; ARCHITECTURE.md gives why they end.
+
+mod split;
+#[cfg(test)]
+mod tests;
+
+use crate::check::{Certificate, CertifyOptions, MeshView};
+use crate::constrained::cdt::Cdt as Tets;
+use crate::constrained::free;
+use crate::constrained::{PlcOptions, PlcStats};
+use crate::delaunay::Location;
+use crate::error::{Error, MeshError};
+use crate::geom::Point;
+use crate::mesh::VertexId;
+use crate::output::MeshOut;
+use crate::plc::prepare::PreparedPlc;
+use crate::plc::Plc;
+
+/// Why [`Cdt::insert_vertex`] left a point out (the CDT is then as it was before the
+/// point's own insertion, with any splits made for it kept: they are valid).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InsertError {
+    /// A coordinate is infinite or NaN.
+    #[error("the point {0:?} is not finite")]
+    NotFinite(Point),
+    /// The point lies outside the convex hull of the vertices.
+    #[error("the point {0:?} lies outside the convex hull of the vertices")]
+    OutsideHull(Point),
+    /// The splits it needed went past their bound (see ARCHITECTURE.md).
+    #[error("the point {point:?} needed more than {bound} constraint splits")]
+    TooManySplits {
+        /// The point.
+        point: Point,
+        /// The bound.
+        bound: usize,
+    },
+    /// The Steiner point budget (`-S`) is spent.
+    #[error("the Steiner point budget of {0} is spent")]
+    Budget(usize),
+    /// No cavity of the point is seen whole from it, and no split made one: a bug or a
+    /// configuration the splits do not cover.
+    #[error("the point {0:?} fits no cavity of the CDT")]
+    Refused(Point),
+}
+
+/// What [`Cdt::insert_vertex`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Inserted {
+    /// The point's node index (0-based; the files add the first index).
+    pub node: usize,
+    /// False if the point coincided with a node already there.
+    pub new: bool,
+    /// Constraint splits made first (each adds one Steiner point).
+    pub splits: usize,
+}
+
+/// A constrained Delaunay tetrahedralization of a PLC, kept live for insertions. The
+/// exterior is carved only when a mesh is taken out ([`Cdt::mesh`]).
+pub struct Cdt {
+    plc: Plc,
+    opts: PlcOptions,
+    /// The PLC as meshed (facet indices of the subfaces), when it differs from `base`.
+    split: Option<PreparedPlc>,
+    /// The PLC as prepared, which certification judges against.
+    base: PreparedPlc,
+    tets: Tets,
+    stats: PlcStats,
+    warnings: Vec<String>,
+    /// The next perturbation (and node) index: above every one in use.
+    next_pert: u32,
+    /// Steiner points added by insertions.
+    added: usize,
+}
+
+impl Cdt {
+    /// The CDT of `plc` (read → Delaunay → segments → facets), not carved.
+    pub fn build(plc: &Plc, opts: &PlcOptions) -> Result<Cdt, Error> {
+        crate::precheck::check_elements(plc)?;
+        crate::precheck::check_surface(plc, &crate::precheck::check_elements(plc)?)?;
+        let c = crate::constrained::construct(plc, opts, &crate::progress::no_progress)?;
+        let built = *c.built;
+        let mut tets = built.cdt;
+        tets.subsegs = built.seg_markers;
+        let next_pert = tets.dt.orig.iter().map(|&o| o + 1).max().unwrap_or(0);
+        let next_pert = next_pert.max(plc.points.len() as u32);
+        Ok(Cdt {
+            plc: plc.clone(),
+            opts: opts.clone(),
+            split: c.split,
+            base: c.base,
+            tets,
+            stats: c.stats,
+            warnings: c.warnings,
+            next_pert,
+            added: 0,
+        })
+    }
+
+    /// Warnings from building it.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The figures of its construction.
+    pub fn stats(&self) -> &PlcStats {
+        &self.stats
+    }
+
+    /// The number of vertices (input points meshed, and Steiner points).
+    pub fn num_vertices(&self) -> usize {
+        self.tets.dt.points.len()
+    }
+
+    /// The number of tets, the exterior not yet carved.
+    pub fn num_tets(&self) -> usize {
+        self.tets.num_tets()
+    }
+
+    /// The number of subsegments and of subfaces.
+    pub fn num_constraints(&self) -> (usize, usize) {
+        (self.tets.subsegs.len(), self.tets.subfaces.len())
+    }
+
+    /// Steiner points added by insertions so far (the inserted points and their splits).
+    pub fn added_points(&self) -> usize {
+        self.added
+    }
+
+    /// The mesh, carved, in output form.
+    pub fn mesh(&self) -> Result<MeshOut, Error> {
+        let prep = self.split.as_ref().unwrap_or(&self.base);
+        let mut stats = self.stats.clone();
+        crate::constrained::carve_copy(&self.plc, prep, &self.tets, &self.opts, &mut stats)
+    }
+
+    /// Certifies the carved mesh as a CDT of the PLC ([`crate::check`]).
+    pub fn certify(&self) -> Result<Certificate, Error> {
+        let mesh = self.mesh()?;
+        let view = MeshView {
+            points: &mesh.points,
+            tets: &mesh.tets,
+            first_index: mesh.first_index,
+        };
+        let opts = CertifyOptions {
+            keep_hull: self.opts.keep_hull,
+            merge: self.opts.merge,
+        };
+        crate::check::certify_prepared(&self.plc, Some(&self.base), view, &opts)
+            .map_err(|f| MeshError::NotCertified(f).into())
+    }
+
+    /// Inserts point `p`, splitting the constraints it lands on or encroaches upon.
+    pub fn insert_vertex(&mut self, p: Point) -> Result<Inserted, InsertError> {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(InsertError::NotFinite(p));
+        }
+        let bound = self.split_bound();
+        let mut splits = 0;
+        // Whether `p` itself split the constraint it lies on.
+        let mut placed = false;
+        loop {
+            let found = match self.tets.dt.locate_anywhere(&p) {
+                Location::Vertex(v) => {
+                    let new = placed && self.tets.dt.points[v as usize] == p;
+                    return Ok(Inserted {
+                        node: self.tets.dt.orig[v as usize] as usize,
+                        new,
+                        splits: splits - new as usize,
+                    });
+                }
+                Location::Outside(_) => return Err(InsertError::OutsideHull(p)),
+                Location::Inside(t) => t,
+            };
+            self.check_budget()?;
+            let on = split::on_constraint(&self.tets, found, &p);
+            placed |= on.is_some();
+            let step = match on {
+                Some(split::On::Subsegment(a, b)) => self.split_subsegment_at(a, b, p)?,
+                Some(split::On::Subface(f)) => self.split_subface_at(f, p)?,
+                None => match split::encroached(self, &p) {
+                    Some((a, b)) => Step::Split(self.split_subsegment(a, b)?),
+                    None => self.insert_free(p)?,
+                },
+            };
+            match step {
+                Step::Done(v) => {
+                    return Ok(Inserted {
+                        node: self.tets.dt.orig[v as usize] as usize,
+                        new: true,
+                        splits,
+                    })
+                }
+                Step::Split(n) => {
+                    splits += n;
+                    if splits > bound {
+                        return Err(InsertError::TooManySplits { point: p, bound });
+                    }
+                }
+            }
+        }
+    }
+
+    /// The most splits one insertion may make: every split adds a vertex inside a
+    /// constraint whose pieces stay at least a fixed fraction of the local feature size
+    /// (ARCHITECTURE.md), so a cascade longer than a multiple of the constraints and
+    /// vertices there are means that argument's premises failed.
+    fn split_bound(&self) -> usize {
+        let (s, f) = self.num_constraints();
+        4 * (s + f + self.num_vertices()) + 64
+    }
+
+    fn check_budget(&self) -> Result<(), InsertError> {
+        let used = self.stats.steiner_points + self.added;
+        if used >= self.opts.max_steiner {
+            return Err(InsertError::Budget(self.opts.max_steiner));
+        }
+        Ok(())
+    }
+
+    /// A point that lands on no constraint and encroaches upon no subsegment: a walled
+    /// cavity and flips; where the CDT refuses it, the constraint in the way is split.
+    fn insert_free(&mut self, p: Point) -> Result<Step, InsertError> {
+        let at = free::subsegment_ends(&self.tets);
+        let inserted = free::insert_point(&mut self.tets, p, self.next_pert, &at, true)
+            .map_err(|_| InsertError::Refused(p))?;
+        match inserted {
+            free::Inserted::Yes { vertex, .. } => {
+                self.next_pert += 1;
+                self.added += 1;
+                Ok(Step::Done(vertex))
+            }
+            free::Inserted::OnVertex => Err(InsertError::Refused(p)),
+            free::Inserted::Refused {
+                lost: Some((a, b)), ..
+            } => Ok(Step::Split(self.split_subsegment(a, b)?)),
+            free::Inserted::Refused {
+                wrapped: Some(f), ..
+            } => Ok(Step::Split(self.split_subface(f)?)),
+            free::Inserted::Refused { .. } => Err(InsertError::Refused(p)),
+        }
+    }
+}
+
+/// One step of an insertion.
+enum Step {
+    /// The point is in, as this vertex.
+    Done(VertexId),
+    /// Constraints were split (this many points), and the point is tried again.
+    Split(usize),
+}

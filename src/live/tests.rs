@@ -1,0 +1,154 @@
+//! Each kind of insertion on small CDTs, certified after every step.
+
+use super::*;
+
+fn model(name: &str) -> Plc {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
+    crate::io::read_plc(&path).unwrap()
+}
+
+/// Inserts `p`, certifies, and returns what the insertion did.
+fn insert_certified(cdt: &mut Cdt, p: Point) -> Inserted {
+    let done = cdt
+        .insert_vertex(p)
+        .unwrap_or_else(|e| panic!("{p:?}: {e}"));
+    if let Err(e) = cdt.certify() {
+        panic!("after {p:?}: {e}");
+    }
+    done
+}
+
+#[test]
+fn a_point_inside_goes_in_without_splits() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (segs, faces) = cdt.num_constraints();
+    let done = insert_certified(&mut cdt, [0.4, 0.45, 0.5]);
+    assert!(done.new);
+    assert_eq!(done.splits, 0);
+    assert_eq!(done.node, 8);
+    assert_eq!(cdt.num_constraints(), (segs, faces));
+    // Again: the same node, nothing new.
+    let again = cdt.insert_vertex([0.4, 0.45, 0.5]).unwrap();
+    assert_eq!((again.node, again.new), (8, false));
+    assert_eq!(cdt.mesh().unwrap().points.len(), 9);
+}
+
+#[test]
+fn a_point_on_a_subsegment_splits_it_and_its_subfaces() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (segs, faces) = cdt.num_constraints();
+    // Every edge of the cube is a segment; (0.5, 0, 0) lies on one, exactly.
+    let done = insert_certified(&mut cdt, [0.5, 0.0, 0.0]);
+    assert!(done.new);
+    assert_eq!(cdt.num_constraints(), (segs + 1, faces + 2));
+    let mesh = cdt.mesh().unwrap();
+    let node = done.node as u32;
+    let pieces = mesh
+        .subsegments
+        .iter()
+        .filter(|(e, _)| e.contains(&node))
+        .count();
+    assert_eq!(pieces, 2);
+}
+
+#[test]
+fn a_point_on_a_subface_splits_it_in_three() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (segs, faces) = cdt.num_constraints();
+    // On the face z = 0, inside one of its two triangles whatever the diagonal.
+    let done = insert_certified(&mut cdt, [0.5, 0.25, 0.0]);
+    let (s, f) = cdt.num_constraints();
+    // It lies in the diametral ball of the edge y = 0, which is split first.
+    assert!(s > segs);
+    assert!(f >= faces + 2, "{f} subfaces from {faces}");
+    assert!(done.new);
+    let mesh = cdt.mesh().unwrap();
+    let node = done.node as u32;
+    assert!(
+        mesh.subfaces
+            .iter()
+            .filter(|(t, _)| t.contains(&node))
+            .count()
+            >= 3
+    );
+}
+
+#[test]
+fn a_point_near_a_segment_splits_what_it_encroaches_upon_first() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (segs, _) = cdt.num_constraints();
+    // Inside the diametral ball of the edge from (0,0,0) to (1,0,0).
+    let done = insert_certified(&mut cdt, [0.3, 0.05, 0.05]);
+    assert!(done.splits >= 1);
+    assert!(cdt.num_constraints().0 > segs);
+    // The point itself went in, off the segments.
+    assert!(done.new);
+    let mesh = cdt.mesh().unwrap();
+    assert_eq!(mesh.points[done.node], [0.3, 0.05, 0.05]);
+}
+
+#[test]
+fn points_outside_the_hull_and_not_finite_are_refused_without_change() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let n = cdt.num_tets();
+    assert_eq!(
+        cdt.insert_vertex([2.0, 0.5, 0.5]),
+        Err(InsertError::OutsideHull([2.0, 0.5, 0.5]))
+    );
+    assert!(matches!(
+        cdt.insert_vertex([f64::NAN, 0.0, 0.0]),
+        Err(InsertError::NotFinite(_))
+    ));
+    assert_eq!(cdt.num_tets(), n);
+    cdt.certify().unwrap();
+}
+
+#[test]
+fn the_steiner_budget_bounds_insertions() {
+    let opts = PlcOptions {
+        max_steiner: 1,
+        ..Default::default()
+    };
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &opts).unwrap();
+    cdt.insert_vertex([0.5, 0.5, 0.5]).unwrap();
+    assert_eq!(
+        cdt.insert_vertex([0.25, 0.5, 0.5]),
+        Err(InsertError::Budget(1))
+    );
+}
+
+/// Points in the hole, on the hole's walls, near its edges, and in the solid: the
+/// carved mesh stays a CDT after each, and the hole stays empty.
+#[test]
+fn a_box_with_a_hole_takes_points_everywhere() {
+    let plc = model("data/examples/box_with_hole.poly");
+    let mut cdt = Cdt::build(&plc, &Default::default()).unwrap();
+    let mut lcg = 7u64;
+    let [lo, hi] = crate::geom::bounding_box(&plc.points);
+    for _ in 0..40 {
+        let p: Point =
+            std::array::from_fn(|k| lo[k] + (hi[k] - lo[k]) * crate::geom::lcg(&mut lcg));
+        insert_certified(&mut cdt, p);
+    }
+    // Exactly on the boundary's vertices' grid: faces, edges.
+    let corner = plc.points[0];
+    let other = plc.points[1];
+    let mid: Point = std::array::from_fn(|k| 0.5 * (corner[k] + other[k]));
+    insert_certified(&mut cdt, mid);
+    assert!(cdt.added_points() >= 41);
+}
+
+/// The nearly flat grids: their polygons are not flat, and points on and near them go
+/// in with their facets' triangulations split in place.
+#[test]
+fn points_go_into_a_nearly_flat_grid() {
+    let plc = model("data/plc/flat_grid_6.poly");
+    let mut cdt = Cdt::build(&plc, &Default::default()).unwrap();
+    let mut lcg = 3u64;
+    let [lo, hi] = crate::geom::bounding_box(&plc.points);
+    for _ in 0..30 {
+        let p: Point =
+            std::array::from_fn(|k| lo[k] + (hi[k] - lo[k]) * crate::geom::lcg(&mut lcg));
+        insert_certified(&mut cdt, p);
+    }
+}
