@@ -92,8 +92,8 @@ pub struct Cdt {
 impl Cdt {
     /// The CDT of `plc` (read → Delaunay → segments → facets), not carved.
     pub fn build(plc: &Plc, opts: &PlcOptions) -> Result<Cdt, Error> {
-        crate::precheck::check_elements(plc)?;
-        crate::precheck::check_surface(plc, &crate::precheck::check_elements(plc)?)?;
+        let elements = crate::precheck::check_elements(plc)?;
+        crate::precheck::check_surface(plc, &elements)?;
         let c = crate::constrained::construct(plc, opts, &crate::progress::no_progress)?;
         let built = *c.built;
         let mut tets = built.cdt;
