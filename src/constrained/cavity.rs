@@ -1370,39 +1370,10 @@ pub(crate) fn steiner_point(
     largest_centroid(cdt, tris)
 }
 
-/// The circumcenter of triangle `f` (an inexact construction: it only places a Steiner
-/// point, it never decides topology).
+/// The circumcenter of triangle `f` (see [`crate::geom::encroach::circumcenter`]).
 fn circumcenter(cdt: &Cdt, f: [VertexId; 3]) -> Point {
     let [a, b, c] = f.map(|v| cdt.dt.points[v as usize]);
-    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let ac = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        ab[1] * ac[2] - ab[2] * ac[1],
-        ab[2] * ac[0] - ab[0] * ac[2],
-        ab[0] * ac[1] - ab[1] * ac[0],
-    ];
-    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    let ab2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
-    let ac2 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2];
-    // (|ab|² (ac × n) + |ac|² (n × ab)) / (2 |n|²)
-    let acn = [
-        ac[1] * n[2] - ac[2] * n[1],
-        ac[2] * n[0] - ac[0] * n[2],
-        ac[0] * n[1] - ac[1] * n[0],
-    ];
-    let nab = [
-        n[1] * ab[2] - n[2] * ab[1],
-        n[2] * ab[0] - n[0] * ab[2],
-        n[0] * ab[1] - n[1] * ab[0],
-    ];
-    if nn == 0.0 {
-        return [
-            (a[0] + b[0] + c[0]) / 3.0,
-            (a[1] + b[1] + c[1]) / 3.0,
-            (a[2] + b[2] + c[2]) / 3.0,
-        ];
-    }
-    std::array::from_fn(|k| a[k] + (ab2 * acn[k] + ac2 * nab[k]) / (2.0 * nn))
+    crate::geom::encroach::circumcenter(&a, &b, &c)
 }
 
 #[cfg(test)]

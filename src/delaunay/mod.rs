@@ -573,7 +573,7 @@ impl Delaunay {
             let bad: Vec<TetId> = self
                 .boundary
                 .iter()
-                .filter(|b| b.v[3] != GHOST && !b.v.contains(&GHOST) && self.orientation(b.v) <= 0)
+                .filter(|b| !b.v.contains(&GHOST) && self.orientation(b.v) <= 0)
                 .map(|b| self.mesh.adj(b.outside).tet())
                 .collect();
             if bad.is_empty() {

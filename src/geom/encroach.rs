@@ -34,20 +34,12 @@ pub fn on_triangle(a: &Point, b: &Point, c: &Point, p: &Point) -> bool {
         return false;
     }
     // The projection along the normal's largest component keeps the triangle's area.
-    let n = super::cross(&super::sub(b, a), &super::sub(c, a));
-    let drop = (0..3)
-        .max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
-        .unwrap_or(2);
-    let (i, j) = match drop {
-        0 => (1, 2),
-        1 => (2, 0),
-        _ => (0, 1),
-    };
-    let q = |x: &Point| [x[i], x[j]];
+    let proj =
+        super::polygon::Projection::along(&super::cross(&super::sub(b, a), &super::sub(c, a)));
     let s = [
-        robust_orient2d(q(a), q(b), q(p)),
-        robust_orient2d(q(b), q(c), q(p)),
-        robust_orient2d(q(c), q(a), q(p)),
+        proj.orient(a, b, p),
+        proj.orient(b, c, p),
+        proj.orient(c, a, p),
     ];
     s.iter().all(|&x| x > 0.0) || s.iter().all(|&x| x < 0.0)
 }
@@ -78,12 +70,17 @@ pub fn in_equatorial_ball(a: &Point, b: &Point, c: &Point, p: &Point) -> bool {
     lhs.sub(&rhs).sign() < 0
 }
 
-/// The circumcentre of triangle `a b c` (rounded), in its plane.
+/// The circumcentre of triangle `a b c` (rounded), in its plane; the centroid of a
+/// triangle whose rounded normal vanishes. An inexact construction: it places points,
+/// it never decides topology.
 pub fn circumcenter(a: &Point, b: &Point, c: &Point) -> Point {
     let u = super::sub(b, a);
     let v = super::sub(c, a);
     let n = super::cross(&u, &v);
     let nn = super::dot(&n, &n);
+    if nn == 0.0 {
+        return std::array::from_fn(|k| (a[k] + b[k] + c[k]) / 3.0);
+    }
     let w1 = super::cross(&v, &n);
     let w2 = super::cross(&n, &u);
     let (uu, vv) = (super::dot(&u, &u), super::dot(&v, &v));
