@@ -1,6 +1,7 @@
-//! Builds the CDT of a PLC, inserts vertices into it one at a time (inside, exactly on a
-//! segment, exactly on a facet, near a segment), certifies it after each step, and
-//! writes the carved mesh.
+//! Builds the CDT of a PLC, inserts a polygon (a new facet across the middle of the
+//! model) and vertices (inside, exactly on a segment, exactly on a facet, near a
+//! segment) into it one at a time, certifies it after each step, and writes the carved
+//! mesh.
 //!
 //! `cargo run --release --example incremental -- data/examples/box_with_hole.poly /tmp/out`
 
@@ -22,6 +23,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let [lo, hi] = tetcdt::geom::bounding_box(&plc.points);
     let at = |s: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| lo[k] + s[k] * (hi[k] - lo[k])) };
+    let polygon = [
+        at([0.1, 0.1, 0.15]),
+        at([0.9, 0.12, 0.18]),
+        at([0.85, 0.9, 0.15]),
+        at([0.15, 0.85, 0.12]),
+    ];
+    match cdt.insert_polygon(&polygon, 9) {
+        Ok(done) => {
+            let cert = cdt.certify()?;
+            println!(
+                "polygon: corners {:?}, {} subfaces, {} points added; certified: {} tets",
+                done.corners, done.subfaces, done.added, cert.tets
+            );
+        }
+        Err(e) => println!("polygon not inserted: {e}"),
+    }
     let a = plc.points[0];
     let b = plc.points[1];
     let points = [

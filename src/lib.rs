@@ -6,8 +6,8 @@
 //! resulting [`output::MeshOut`]. [`check`] validates a mesh independently.
 //!
 //! [`live::Cdt`] keeps a PLC's CDT live: vertices go in one at a time, on segments and
-//! facets or anywhere inside, each insertion leaving a CDT that [`live::Cdt::certify`]
-//! checks (see `examples/incremental.rs`):
+//! facets or anywhere inside, and polygons as new facets, each insertion leaving a CDT
+//! that [`live::Cdt::certify`] checks (see `examples/incremental.rs`):
 //!
 //! ```
 //! use tetcdt::live::Cdt;
@@ -17,8 +17,12 @@
 //! let on_edge = cdt.insert_vertex([0.5, 0.0, 0.0]).unwrap();
 //! assert!(on_edge.new);
 //! cdt.certify().unwrap();
+//! let square = [[0.2, 0.2, 0.5], [0.8, 0.2, 0.5], [0.8, 0.8, 0.5], [0.2, 0.8, 0.5]];
+//! let inside = cdt.insert_polygon(&square, 3).unwrap();
+//! assert!(inside.subfaces >= 2);
+//! cdt.certify().unwrap();
 //! let mesh = cdt.mesh().unwrap();
-//! assert_eq!(mesh.points.len(), 9);
+//! assert!(mesh.subfaces.iter().any(|&(_, marker)| marker == 3));
 //! ```
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

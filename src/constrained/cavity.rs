@@ -23,8 +23,9 @@ use rustc_hash::{FxHashMap, FxHashSet};
 /// Figures of one region insertion (rows of the paper's Table 1).
 #[derive(Clone, Debug, Default)]
 pub struct RegionStats {
-    /// Facets whose subfaces the retriangulation destroyed; they must be inserted again.
-    pub lost: Vec<u32>,
+    /// Subfaces (of other facets) that the retriangulation destroyed, with their facets,
+    /// sorted: they must be inserted again.
+    pub lost: Vec<([VertexId; 3], u32)>,
     /// Tets crossing the region, deleted.
     pub crossing_tets: usize,
     /// Tets added to the cavity because a cavity face was missing.
@@ -331,21 +332,10 @@ fn replace_cavity(
         }
     }
     graft(cdt, cavity, &top_side.0, &bottom_side.0, &new_tets)?;
-    let mut lost = Vec::new();
-    at_risk.sort_unstable();
-    at_risk.dedup();
-    for key in at_risk {
-        if cdt.find_face(key[0], key[1], key[2]).is_none() {
-            if let Some(f) = cdt.subfaces.remove(&key) {
-                lost.push(f);
-            }
-        }
-    }
+    let lost = cdt.take_lost_subfaces(&mut at_risk);
     for t in tris {
         cdt.subfaces.insert(face_key(*t), facet);
     }
-    lost.sort_unstable();
-    lost.dedup();
     Ok(Outcome::Inserted(RegionStats {
         lost,
         crossing_tets: crossing,

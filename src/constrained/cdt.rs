@@ -121,6 +121,25 @@ impl Cdt {
         self.find_face(a, b, c)
     }
 
+    /// Removes the subfaces among `at_risk` (drained) that are no longer mesh faces:
+    /// they, with their facets, sorted.
+    pub fn take_lost_subfaces(
+        &mut self,
+        at_risk: &mut Vec<[VertexId; 3]>,
+    ) -> Vec<([VertexId; 3], u32)> {
+        at_risk.sort_unstable();
+        at_risk.dedup();
+        let mut lost = Vec::new();
+        for key in at_risk.drain(..) {
+            if self.find_face(key[0], key[1], key[2]).is_none() {
+                if let Some(f) = self.subfaces.remove(&key) {
+                    lost.push((key, f));
+                }
+            }
+        }
+        lost
+    }
+
     /// True if `(a, b, c)` is a face of the mesh.
     pub fn has_face(&mut self, a: VertexId, b: VertexId, c: VertexId) -> bool {
         self.face_ref(a, b, c).is_some()

@@ -440,7 +440,10 @@ impl<'a> Construction<'a> {
                     stats.max_region_crossing_tets =
                         stats.max_region_crossing_tets.max(rs.crossing_tets);
                     stats.enlarged_tets += rs.enlarged_tets;
-                    for lf in rs.lost {
+                    let mut lost: Vec<u32> = rs.lost.iter().map(|&(_, f)| f).collect();
+                    lost.sort_unstable();
+                    lost.dedup();
+                    for lf in lost {
                         if let Some(q) = self.queued.get_mut(lf as usize).filter(|q| !**q) {
                             *q = true;
                             self.queue.push(lf as usize);
@@ -1180,7 +1183,7 @@ pub(super) fn resolve_shims(
 
 /// Groups missing triangles into regions connected through shared edges that are not
 /// subsegments.
-fn regions_of(
+pub(crate) fn regions_of(
     missing: &[[VertexId; 3]],
     subsegs: &FxHashMap<(VertexId, VertexId), i32>,
 ) -> Vec<Vec<[VertexId; 3]>> {

@@ -381,7 +381,7 @@ pub fn insert_region(
             if super::debug() {
                 eprintln!("facet {facet}: flips fall back to the cavity code ({p:?})");
             }
-            let mut lost = lost_subfaces(cdt, &mut at_risk);
+            let mut lost = cdt.take_lost_subfaces(&mut at_risk);
             return Ok(match cavity::insert_region(cdt, tris, facet, normal)? {
                 Outcome::Inserted(mut rs) => {
                     rs.lost.append(&mut lost);
@@ -393,7 +393,7 @@ pub fn insert_region(
             });
         }
     }
-    let lost = lost_subfaces(cdt, &mut at_risk);
+    let lost = cdt.take_lost_subfaces(&mut at_risk);
     for t in tris {
         cdt.subfaces.insert(face_key(*t), facet);
     }
@@ -410,23 +410,6 @@ fn nearest_triangle(tris: &[[VertexId; 3]], near: &[VertexId]) -> Option<[Vertex
     tris.iter()
         .max_by_key(|t| t.iter().filter(|x| near.contains(x)).count())
         .copied()
-}
-
-/// Removes the subfaces among `at_risk` that are no longer mesh faces; their facets.
-fn lost_subfaces(cdt: &mut Cdt, at_risk: &mut Vec<[VertexId; 3]>) -> Vec<u32> {
-    at_risk.sort_unstable();
-    at_risk.dedup();
-    let mut lost = Vec::new();
-    for key in at_risk.drain(..) {
-        if cdt.find_face(key[0], key[1], key[2]).is_none() {
-            if let Some(f) = cdt.subfaces.remove(&key) {
-                lost.push(f);
-            }
-        }
-    }
-    lost.sort_unstable();
-    lost.dedup();
-    lost
 }
 
 /// Three region vertices spanning approximately the largest triangle: the farthest

@@ -21,6 +21,8 @@ mod in_place;
 pub mod segments;
 mod slivers;
 
+pub(crate) use construction::regions_of;
+
 use crate::carve::carve;
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};

@@ -17,6 +17,7 @@
 //! subsegment, or wrap around a subface, gets that constraint split first too. The
 //! splits are queue-driven; ARCHITECTURE.md gives why they end.
 
+mod polygon;
 mod split;
 #[cfg(test)]
 mod tests;
@@ -32,6 +33,8 @@ use crate::mesh::VertexId;
 use crate::output::MeshOut;
 use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
+
+pub use polygon::{PolygonError, PolygonInserted};
 
 /// Why [`Cdt::insert_vertex`] left a point out (the CDT is then as it was before the
 /// point's own insertion, with any splits made for it kept: they are valid).
@@ -74,12 +77,22 @@ pub struct Inserted {
 /// A constrained Delaunay tetrahedralization of a PLC, kept live for insertions. The
 /// exterior is carved only when a mesh is taken out ([`Cdt::mesh`]).
 pub struct Cdt {
+    /// The PLC as given to [`Cdt::build`]: its points are the first output nodes, its
+    /// holes and regions carve the mesh.
     plc: Plc,
     opts: PlcOptions,
-    /// The PLC as meshed (facet indices of the subfaces), when it differs from `base`.
-    split: Option<PreparedPlc>,
-    /// The PLC as prepared, which certification judges against.
-    base: PreparedPlc,
+    /// The facets the subfaces name (by index), with the polygons inserted since.
+    meshed: PreparedPlc,
+    /// The PLC with the polygons inserted since (their vertices appended as points),
+    /// which certification judges against, and its preparation.
+    judged: (Plc, PreparedPlc),
+    /// Vertices treated as input vertices when a subsegment is split: those of the PLC,
+    /// and the corners of inserted polygons (the power-of-two shells protect the angles
+    /// at both).
+    corners: rustc_hash::FxHashSet<VertexId>,
+    /// While a polygon goes in: each split of a subsegment or of a piece of its edges,
+    /// with the split vertex, so that its edges can be followed as chains of subsegments.
+    split_log: Option<Vec<((VertexId, VertexId), VertexId)>>,
     tets: Tets,
     stats: PlcStats,
     warnings: Vec<String>,
@@ -103,8 +116,10 @@ impl Cdt {
         Ok(Cdt {
             plc: plc.clone(),
             opts: opts.clone(),
-            split: c.split,
-            base: c.base,
+            meshed: c.split.unwrap_or_else(|| c.base.clone()),
+            judged: (plc.clone(), c.base),
+            corners: Default::default(),
+            split_log: None,
             tets,
             stats: c.stats,
             warnings: c.warnings,
@@ -145,9 +160,8 @@ impl Cdt {
 
     /// The mesh, carved, in output form.
     pub fn mesh(&self) -> Result<MeshOut, Error> {
-        let prep = self.split.as_ref().unwrap_or(&self.base);
         let mut stats = self.stats.clone();
-        crate::constrained::carve_copy(&self.plc, prep, &self.tets, &self.opts, &mut stats)
+        crate::constrained::carve_copy(&self.plc, &self.meshed, &self.tets, &self.opts, &mut stats)
     }
 
     /// Certifies the carved mesh as a CDT of the PLC ([`crate::check`]).
@@ -162,12 +176,24 @@ impl Cdt {
             keep_hull: self.opts.keep_hull,
             merge: self.opts.merge,
         };
-        crate::check::certify_prepared(&self.plc, Some(&self.base), view, &opts)
+        let (plc, prep) = &self.judged;
+        crate::check::certify_prepared(plc, Some(prep), view, &opts)
             .map_err(|f| MeshError::NotCertified(f).into())
     }
 
     /// Inserts point `p`, splitting the constraints it lands on or encroaches upon.
     pub fn insert_vertex(&mut self, p: Point) -> Result<Inserted, InsertError> {
+        let (v, new, splits) = self.insert_vertex_id(p)?;
+        Ok(Inserted {
+            node: self.tets.dt.orig[v as usize] as usize,
+            new,
+            splits,
+        })
+    }
+
+    /// [`Cdt::insert_vertex`] by vertex id: the vertex, whether it is new, and the
+    /// splits made first.
+    fn insert_vertex_id(&mut self, p: Point) -> Result<(VertexId, bool, usize), InsertError> {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(InsertError::NotFinite(p));
         }
@@ -179,11 +205,7 @@ impl Cdt {
             let found = match self.tets.dt.locate_anywhere(&p) {
                 Location::Vertex(v) => {
                     let new = placed && self.tets.dt.points[v as usize] == p;
-                    return Ok(Inserted {
-                        node: self.tets.dt.orig[v as usize] as usize,
-                        new,
-                        splits: splits - new as usize,
-                    });
+                    return Ok((v, new, splits - new as usize));
                 }
                 Location::Outside(_) => return Err(InsertError::OutsideHull(p)),
                 Location::Inside(t) => t,
@@ -200,13 +222,7 @@ impl Cdt {
                 },
             };
             match step {
-                Step::Done(v) => {
-                    return Ok(Inserted {
-                        node: self.tets.dt.orig[v as usize] as usize,
-                        new: true,
-                        splits,
-                    })
-                }
+                Step::Done(v) => return Ok((v, true, splits)),
                 Step::Split(n) => {
                     splits += n;
                     if splits > bound {

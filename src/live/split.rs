@@ -153,17 +153,28 @@ impl Cdt {
                 Target::Face(..) => None,
             };
             let pert = self.next_pert;
+            let mut m = m;
             if let Some(e) = encroached_except(&mut self.tets, &m, pert, skip) {
                 let seg = Target::Edge(e.0, e.1, None);
-                if stack.contains(&seg) {
-                    // Each is in the other's ball: the queue would cycle.
-                    return Err(InsertError::Refused(m));
+                if !stack.contains(&seg) {
+                    if let Target::Face(..) = top {
+                        stack.pop();
+                    }
+                    stack.push(seg);
+                    continue;
                 }
-                if let Target::Face(..) = top {
-                    stack.pop();
-                }
-                stack.push(seg);
-                continue;
+                // Each is in the other's ball. From one vertex at an angle under 60
+                // degrees, Ruppert's concentric shells end that: this one is split on a
+                // power-of-two shell around their common vertex, scaled to the shorter
+                // of the two. Apart (skew and close), it is split as it is, as Ruppert's
+                // algorithm does, and the other next: each split halves the pieces, and
+                // pieces shorter than the distance between the two encroach upon
+                // nothing. The insertion itself refuses to lose a subsegment.
+                m = match top {
+                    Target::Edge(a, b, None) => self.shell_point_between(a, b, e).unwrap_or(m),
+                    Target::Edge(..) => m,
+                    Target::Face(..) => return Err(InsertError::Refused(m)),
+                };
             }
             let in_way = match top {
                 Target::Edge(a, b, _) => self.split_edge(a, b, m)?,
@@ -216,9 +227,10 @@ impl Cdt {
     /// meet at a small angle are then split at equal distances from their common vertex,
     /// and never encroach upon each other), else at its middle. A shell radius `2^k` in
     /// `[L/3, 2L/3]` always exists, so no piece is shorter than a third.
-    fn edge_split_point(&self, a: VertexId, b: VertexId) -> Point {
+    pub(super) fn edge_split_point(&self, a: VertexId, b: VertexId) -> Point {
         let n_input = self.plc.points.len() as u32;
-        let input = |x: VertexId| self.tets.dt.orig[x as usize] < n_input;
+        let input =
+            |x: VertexId| self.tets.dt.orig[x as usize] < n_input || self.corners.contains(&x);
         let (pa, pb) = (
             self.tets.dt.points[a as usize],
             self.tets.dt.points[b as usize],
@@ -232,6 +244,32 @@ impl Cdt {
         let r = (len / 3.0).log2().ceil().exp2();
         let s = if r > 0.0 && r < len { r / len } else { 0.5 };
         std::array::from_fn(|k| from[k] + s * (to[k] - from[k]))
+    }
+
+    /// The point splitting `a`–`b` on the power-of-two shell around its end shared with
+    /// subsegment `e`, with a radius in `[L/3, 2L/3]` of the shorter one's length `L`
+    /// (`None` if they share no end).
+    fn shell_point_between(
+        &self,
+        a: VertexId,
+        b: VertexId,
+        e: (VertexId, VertexId),
+    ) -> Option<Point> {
+        let (c, far) = if a == e.0 || a == e.1 {
+            (a, b)
+        } else if b == e.0 || b == e.1 {
+            (b, a)
+        } else {
+            return None;
+        };
+        let other = if e.0 == c { e.1 } else { e.0 };
+        let pt = |x: VertexId| self.tets.dt.points[x as usize];
+        let len = |x: VertexId| crate::geom::norm(&crate::geom::sub(&pt(x), &pt(c)));
+        let (l, shorter) = (len(far), len(far).min(len(other)));
+        let r = (shorter / 3.0).log2().ceil().exp2();
+        let s = if r > 0.0 && r < l { r / l } else { 0.5 };
+        let (from, to) = (pt(c), pt(far));
+        Some(std::array::from_fn(|k| from[k] + s * (to[k] - from[k])))
     }
 
     /// The subfaces through edge `a`–`b`.
@@ -458,7 +496,13 @@ impl Cdt {
                 cdt.subsegs.insert(edge_key(a, b), k);
             }
         };
-        self.settle_split(m, (vertex, change, last), &made, undo_tables)
+        let settled = self.settle_split(m, (vertex, change, last), &made, undo_tables)?;
+        if let (Ok(()), Some(_), Some((a, b)), Some(log)) =
+            (&settled, marker, edge, &mut self.split_log)
+        {
+            log.push((edge_key(a, b), vertex));
+        }
+        Ok(settled)
     }
 
     /// After a split point went in and the constraint tables were updated: flips to

@@ -152,3 +152,88 @@ fn points_go_into_a_nearly_flat_grid() {
         insert_certified(&mut cdt, p);
     }
 }
+
+/// Inserts polygon `ring`, certifies, and returns what the insertion did.
+fn polygon_certified(cdt: &mut Cdt, ring: &[Point], marker: i32) -> PolygonInserted {
+    let done = cdt
+        .insert_polygon(ring, marker)
+        .unwrap_or_else(|e| panic!("{ring:?}: {e}"));
+    if let Err(e) = cdt.certify() {
+        panic!("after {ring:?}: {e}");
+    }
+    done
+}
+
+#[test]
+fn a_square_inside_a_cube_becomes_a_facet() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (segs, faces) = cdt.num_constraints();
+    let sq = [
+        [0.2, 0.2, 0.5],
+        [0.8, 0.2, 0.5],
+        [0.8, 0.8, 0.5],
+        [0.2, 0.8, 0.5],
+    ];
+    let done = polygon_certified(&mut cdt, &sq, 7);
+    // The corners encroach upon the cube's vertical edges, which are split first.
+    let mesh = cdt.mesh().unwrap();
+    let at: Vec<Point> = done.corners.iter().map(|&c| mesh.points[c]).collect();
+    assert_eq!(at, sq);
+    assert!(done.added >= 4);
+    assert!(done.subfaces >= 2);
+    let (s, f) = cdt.num_constraints();
+    assert!(s >= segs + 4);
+    assert!(f >= faces + done.subfaces);
+    let mesh = cdt.mesh().unwrap();
+    assert_eq!(
+        mesh.subfaces.iter().filter(|(_, m)| *m == 7).count(),
+        done.subfaces
+    );
+    // A point just above the square, inside its equatorial balls, goes in too.
+    insert_certified(&mut cdt, [0.5, 0.45, 0.52]);
+}
+
+#[test]
+fn a_tilted_triangle_and_a_polygon_sharing_its_edge_go_in() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let a = [0.2, 0.3, 0.3];
+    let b = [0.7, 0.2, 0.4];
+    let c = [0.6, 0.8, 0.7];
+    polygon_certified(&mut cdt, &[a, b, c], 1);
+    // Another polygon on the edge a–b, folded away from the first.
+    polygon_certified(&mut cdt, &[b, a, [0.4, 0.1, 0.8]], 2);
+    for p in [[0.45, 0.3, 0.45], [0.5, 0.5, 0.5], [0.35, 0.25, 0.35]] {
+        insert_certified(&mut cdt, p);
+    }
+}
+
+#[test]
+fn polygons_that_break_the_plc_are_refused_without_change() {
+    let mut cdt = Cdt::build(&model("data/examples/cube.poly"), &Default::default()).unwrap();
+    let (n, segs) = (cdt.num_vertices(), cdt.num_constraints());
+    // Through the cube's side x = 1.
+    let through = [[0.5, 0.5, 0.5], [1.5, 0.5, 0.5], [1.5, 0.6, 0.6]];
+    assert!(matches!(
+        cdt.insert_polygon(&through, 1),
+        Err(PolygonError::Invalid(_)) | Err(PolygonError::Vertex(InsertError::OutsideHull(_)))
+    ));
+    let sq = [[0.2, 0.2, 0.5], [0.8, 0.2, 0.5], [0.8, 0.8, 0.5]];
+    polygon_certified(&mut cdt, &sq, 1);
+    // Crossing the first.
+    let crossing = [[0.5, 0.4, 0.2], [0.6, 0.4, 0.8], [0.5, 0.5, 0.8]];
+    assert!(matches!(
+        cdt.insert_polygon(&crossing, 1),
+        Err(PolygonError::Invalid(_))
+    ));
+    assert!(matches!(
+        cdt.insert_polygon(&[[0.1, 0.1, 0.1], [0.2, 0.2, 0.2], [0.3, 0.3, 0.3]], 1),
+        Err(PolygonError::Degenerate(_))
+    ));
+    assert!(matches!(
+        cdt.insert_polygon(&[[0.1, 0.1, 0.1], [0.2, 0.2, 0.2]], 1),
+        Err(PolygonError::Degenerate(_))
+    ));
+    assert!(cdt.num_vertices() >= n + 3);
+    assert!(cdt.num_constraints().0 > segs.0);
+    cdt.certify().unwrap();
+}
