@@ -16,6 +16,8 @@
 //! input vertex), and the point tried again. A point whose walled cavity would remove a
 //! subsegment, or wrap around a subface, gets that constraint split first too. The
 //! splits are queue-driven; ARCHITECTURE.md gives why they end.
+//!
+//! [`Cdt::insert_polygon`] adds a polygon as a new facet, all or nothing (`polygon.rs`).
 
 mod polygon;
 mod split;
