@@ -82,6 +82,18 @@ pub enum MeshError {
     /// given (a bug, or a PLC the mesher does not handle).
     #[error("the mesh made is not a valid CDT of the PLC, so none is written: {}", .0.report())]
     NotCertified(crate::check::CheckFailure),
+    /// A group of merged input facets (`sources`, 0-based) could not be triangulated in
+    /// one plane: the group is too far from flat. The `-p` driver meshes it again with
+    /// those facets kept apart; the error reaches the user only when they already were.
+    #[error("facet {facet}: {reason}")]
+    UnflatGroup {
+        /// The input facets of the group.
+        sources: Vec<usize>,
+        /// The group's name for messages.
+        facet: String,
+        /// Why its triangulation failed.
+        reason: String,
+    },
     /// A construction passed its bound on work ([`crate::constrained::cdt::Cdt::work_limit`]):
     /// the restarts end as if it had finished over the bound.
     #[error("the construction passed its bound on work")]

@@ -222,9 +222,6 @@ fn max_facet_points(plc: &Plc) -> usize {
 /// (see [`slivers`]).
 const FREE_POINT: usize = usize::MAX;
 
-/// Marks the failure to triangulate a merged group in one plane (then split).
-const UNFLAT_GROUP: &str = "merged facets ";
-
 /// The most restarts for Steiner points on polygons before giving up.
 const MAX_RESTARTS: usize = 24;
 
@@ -383,19 +380,14 @@ pub(crate) fn construct(
             (&mut stats, work_limit),
             progress,
         ) {
-            Err(Error::Mesh(MeshError::Failed(msg)))
-                if msg.starts_with(UNFLAT_GROUP) && retry.is_none() =>
-            {
-                // Which group failed is in the message; split it and start again.
-                let sources: Vec<usize> = msg[UNFLAT_GROUP.len()..]
-                    .split(':')
-                    .next()
-                    .unwrap_or("")
-                    .split(',')
-                    .filter_map(|s| s.trim().parse().ok())
-                    .collect();
+            Err(Error::Mesh(MeshError::UnflatGroup {
+                sources,
+                facet,
+                reason,
+            })) if retry.is_none() => {
+                // The group is split and meshed again, unless it already was.
                 if sources.is_empty() || sources.iter().all(|s| keep_apart.contains(s)) {
-                    return Err(MeshError::Failed(msg[UNFLAT_GROUP.len()..].to_string()).into());
+                    return Err(MeshError::Failed(format!("facet {facet}: {reason}")).into());
                 }
                 best = None;
                 keep_apart.extend(sources);
@@ -951,12 +943,11 @@ impl<'a> FacetContext<'a> {
                 eprintln!("  constraints (output ids) {o:?}");
             }
             if f.source_facets.len() > 1 {
-                let list: Vec<String> = f.source_facets.iter().map(|s| s.to_string()).collect();
-                MeshError::Failed(format!(
-                    "{UNFLAT_GROUP}{}: facet {}: {e}",
-                    list.join(","),
-                    facet_name(plc, f)
-                ))
+                MeshError::UnflatGroup {
+                    sources: f.source_facets.clone(),
+                    facet: facet_name(plc, f),
+                    reason: e,
+                }
             } else {
                 MeshError::Failed(format!("facet {}: {e}", facet_name(plc, f)))
             }
