@@ -1027,3 +1027,37 @@ fn nearly_flat_grids_need_no_steiner_point() {
         }
     }
 }
+
+/// A solid wedge whose two large faces meet at 0.046° along its sharp edge: nearly
+/// coplanar, but folded onto each other rather than bent, so they are two facets (TetGen
+/// merges only polygons whose dihedral angle is within 0.1° of 180°). Merged, the wedge
+/// had no interior; apart, its tets are TetGen's (`tetgen -pO0Q`: 0 3 4 2, 0 4 5 2,
+/// 5 0 2 1).
+#[test]
+fn a_thin_wedge_keeps_its_folded_faces_apart_as_tetgen_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let poly = dir.path().join("wedge.poly");
+    fs::write(
+        &poly,
+        "6 3 0 0\n0 0 0 0\n1 1 0 0\n2 1 1 0\n3 0 1 0\n4 0 1 0.0008\n5 1 1 0.0008\n\
+         5 0\n1\n4 0 1 2 3\n1\n4 0 4 5 1\n1\n4 3 2 5 4\n1\n3 0 3 4\n1\n3 1 5 2\n0\n0\n",
+    )
+    .unwrap();
+    for args in [&["-pQ"][..], &["-pQF"][..]] {
+        let prefix = mesh(&poly, dir.path(), "w", args);
+        let mut tets: Vec<[usize; 4]> = rows(&with_ext(&prefix, "ele"))[1..]
+            .iter()
+            .map(|r| {
+                let mut t: [usize; 4] = std::array::from_fn(|k| r[k + 1].parse().unwrap());
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        tets.sort_unstable();
+        assert_eq!(
+            tets,
+            vec![[0, 1, 2, 5], [0, 2, 3, 4], [0, 2, 4, 5]],
+            "{args:?}"
+        );
+    }
+}

@@ -9,7 +9,9 @@
 //!   dropped.
 //! * All polygons of one input facet form one group. With `merge` (TetGen's default; `-M`
 //!   turns it off), two polygons that are the only two users of an edge and whose Newell
-//!   normals satisfy `|n1·n2| >= cos(0.1°)` are merged too (TetGen's 179.9° tolerance).
+//!   normals satisfy `|n1·n2| >= cos(0.1°)` and that lie on opposite sides of their
+//!   common edge (bent, not folded onto each other) are merged too (TetGen's 179.9°
+//!   tolerance on dihedral angles).
 //! * Every polygon edge is a segment, except an edge used by exactly two polygons that are
 //!   both rings (3 or more vertices) of the same group.
 
@@ -66,6 +68,34 @@ pub struct MergedFacet {
 struct Poly {
     verts: Vec<u32>,
     facet: usize,
+}
+
+/// Whether two polygons (rings `ra`, `rb` with unit normals `na`, `nb`) that share edge
+/// `e` lie on opposite sides of it, as a facet bent by a small angle does (a dihedral
+/// angle near 180°), rather than folded onto each other (near 0°): TetGen merges only
+/// the first. Each ring's interior lies to the left of its edges seen from its normal,
+/// along `n × d` for the edge's direction `d` in that ring.
+fn opposite_sides(
+    pts: &[[f64; 3]],
+    ra: &[u32],
+    na: [f64; 3],
+    rb: &[u32],
+    nb: [f64; 3],
+    e: (u32, u32),
+) -> bool {
+    let inward = |ring: &[u32], n: [f64; 3]| -> Option<[f64; 3]> {
+        let m = ring.len();
+        let k = (0..m).find(|&k| {
+            let (x, y) = (ring[k], ring[(k + 1) % m]);
+            (x.min(y), x.max(y)) == e
+        })?;
+        let (p, q) = (pts[ring[k] as usize], pts[ring[(k + 1) % m] as usize]);
+        Some(crate::geom::cross(&n, &crate::geom::sub(&q, &p)))
+    };
+    match (inward(ra, na), inward(rb, nb)) {
+        (Some(ua), Some(ub)) => crate::geom::dot(&ua, &ub) < 0.0,
+        _ => true,
+    }
 }
 
 /// Union-find with path halving.
@@ -212,7 +242,7 @@ pub fn prepare_except(
         .collect();
     if merge {
         let cos_tol = MERGE_ANGLE_DEG.to_radians().cos();
-        for (_, us) in &edges {
+        for (e, us) in &edges {
             if us.len() != 2 {
                 continue;
             }
@@ -229,7 +259,9 @@ pub fn prepare_except(
             }
             if let (Some(n1), Some(n2)) = (unit[a], unit[b]) {
                 let d = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2];
-                if d.abs() >= cos_tol {
+                if d.abs() >= cos_tol
+                    && opposite_sides(pts, &polys[a].verts, n1, &polys[b].verts, n2, *e)
+                {
                     dsu.union(a, b);
                 }
             }
@@ -535,6 +567,23 @@ mod tests {
         let p = prepare(&hinge(0.05), false).unwrap();
         assert_eq!(p.facets.len(), 2);
         assert_eq!(p.segments.len(), 5);
+    }
+
+    /// Two triangles sharing edge 0–1 at a dihedral angle of `deg` degrees (folded).
+    fn fold(deg: f64) -> Plc {
+        let t = deg.to_radians();
+        let mut plc = hinge(0.0);
+        plc.points[3] = [0.5, t.cos(), t.sin()];
+        plc
+    }
+
+    #[test]
+    fn folded_polygons_stay_apart_however_close() {
+        for deg in [0.05, 0.001] {
+            let p = prepare(&fold(deg), true).unwrap();
+            assert_eq!(p.facets.len(), 2, "{deg}°");
+            assert!(p.segments.contains(&[0, 1]));
+        }
     }
 
     #[test]
