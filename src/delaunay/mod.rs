@@ -554,13 +554,17 @@ impl Delaunay {
     /// (every boundary face makes a positive tet with it), as a cavity in a constrained
     /// tetrahedralization must be: a tet with a boundary face the vertex does not see
     /// strictly leaves, with the tets it alone connected to `seeds`, and the boundary is
-    /// made again. False, with the marks cleared, if a seed would have to leave; the
-    /// faces made by filling are then not all locally Delaunay, and flips settle them.
+    /// made again. A boundary face that is `unfillable` (its three vertices and the
+    /// vertex would make a flat tet on a constraint) counts as one it does not see,
+    /// unless a seed holds it.
+    /// False, with the marks cleared, if a seed would have to leave; the faces made by
+    /// filling are then not all locally Delaunay, and flips settle them.
     pub(crate) fn shrink_to_star(
         &mut self,
         pv: VertexId,
         seeds: &[TetId],
         blocked: impl Fn([VertexId; 4], usize) -> bool,
+        unfillable: impl Fn([VertexId; 3]) -> bool,
     ) -> bool {
         // Every tet marked outside during growth is the outside of a boundary face.
         for i in 0..self.boundary.len() {
@@ -573,7 +577,12 @@ impl Delaunay {
             let bad: Vec<TetId> = self
                 .boundary
                 .iter()
-                .filter(|b| !b.v.contains(&GHOST) && self.orientation(b.v) <= 0)
+                .filter(|b| {
+                    !b.v.contains(&GHOST)
+                        && (self.orientation(b.v) <= 0
+                            || (unfillable(FACE_VERTS[b.face].map(|k| b.v[k]))
+                                && !seeds.contains(&self.mesh.adj(b.outside).tet())))
+                })
                 .map(|b| self.mesh.adj(b.outside).tet())
                 .collect();
             if bad.is_empty() {

@@ -184,6 +184,7 @@ impl Delaunay {
         pert: u32,
         seeds: &[TetId],
         blocked: impl Fn([VertexId; 4], usize) -> bool,
+        unfillable: impl Fn([VertexId; 3]) -> bool,
     ) -> Result<Walled, MeshError> {
         if !p.iter().all(|c| c.is_finite()) || seeds.is_empty() {
             return Ok(Walled::Refused);
@@ -191,8 +192,8 @@ impl Delaunay {
         self.widen_box(&p);
         let v = self.push_point(p, pert);
         let grown = self.grow_cavity(v, seeds, &blocked);
-        let ready =
-            matches!(grown, super::Cavity::Ready) && self.shrink_to_star(v, seeds, &blocked);
+        let ready = matches!(grown, super::Cavity::Ready)
+            && self.shrink_to_star(v, seeds, &blocked, unfillable);
         if !(ready && self.boundary_is_a_sphere() && self.fill_is_positive()) {
             if ready {
                 self.abandon_cavity();

@@ -451,10 +451,17 @@ impl Cdt {
             let fv = face_key(FACE_VERTS[f].map(|k| v[k]));
             !open.contains(&fv) && subfaces.contains_key(&fv)
         };
+        // A subface of a facet being split, outside the region, would make a flat tet
+        // (a shim) with `m`, which lies on that facet: the cavity stays off it.
+        let facets: Vec<u32> = region.iter().map(|&(_, f)| f).collect();
+        let unfillable = |fv: [VertexId; 3]| {
+            let k = face_key(fv);
+            !open.contains(&k) && subfaces.get(&k).is_some_and(|f| facets.contains(f))
+        };
         let walled = self
             .tets
             .dt
-            .insert_seeded(m, self.next_pert, &seeds, blocked)
+            .insert_seeded(m, self.next_pert, &seeds, blocked, unfillable)
             .map_err(|_| InsertError::Refused(m))?;
         let Walled::Inserted {
             vertex,
