@@ -21,17 +21,38 @@ pub fn in_diametral_ball(a: &Point, b: &Point, p: &Point) -> bool {
 
 /// True if `p` lies on segment `a`–`b`, strictly between its ends.
 pub fn on_segment(a: &Point, b: &Point, p: &Point) -> bool {
+    near_segment(a, b, p, 0.0)
+}
+
+/// True if `p` lies within distance `tol` of the line through `a` and `b` (exactly on it
+/// when `tol` is 0) and strictly between the planes through its ends across it.
+pub fn near_segment(a: &Point, b: &Point, p: &Point, tol: f64) -> bool {
     let proj = |x: &Point, i: usize, j: usize| [x[i], x[j]];
     let collinear = [(0, 1), (1, 2), (0, 2)]
         .iter()
         .all(|&(i, j)| robust_orient2d(proj(a, i, j), proj(b, i, j), proj(p, i, j)) == 0.0);
-    collinear && dot_diff(p, a, b, a).sign() > 0 && dot_diff(p, b, a, b).sign() > 0
+    let near = collinear || {
+        let d = super::sub(b, a);
+        let off = super::norm(&super::cross(&super::sub(p, a), &d));
+        off <= tol * super::norm(&d)
+    };
+    near && dot_diff(p, a, b, a).sign() > 0 && dot_diff(p, b, a, b).sign() > 0
 }
 
 /// True if `p` lies in the plane of triangle `a b c` and strictly inside it.
 pub fn on_triangle(a: &Point, b: &Point, c: &Point, p: &Point) -> bool {
+    near_triangle(a, b, c, p, 0.0)
+}
+
+/// True if `p` lies within distance `tol` of the plane of triangle `a b c` (exactly in
+/// it when `tol` is 0) and, seen along the plane's normal, strictly inside it.
+pub fn near_triangle(a: &Point, b: &Point, c: &Point, p: &Point, tol: f64) -> bool {
     if orient3d(a, b, c, p) != 0.0 {
-        return false;
+        let n = super::cross(&super::sub(b, a), &super::sub(c, a));
+        let off = super::dot(&n, &super::sub(p, a)).abs();
+        if off.is_nan() || off > tol * super::norm(&n) {
+            return false;
+        }
     }
     // The projection along the normal's largest component keeps the triangle's area.
     let proj =

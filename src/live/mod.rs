@@ -98,6 +98,10 @@ pub struct Cdt {
     tets: Tets,
     stats: PlcStats,
     warnings: Vec<String>,
+    /// Points this close to a subsegment or subface lie on it: the certifier's thinnest
+    /// slab of a facet (1e-10 of the model's diagonal), which rounding puts points
+    /// computed on a facet within.
+    near: f64,
     /// The next perturbation (and node) index: above every one in use.
     next_pert: u32,
     /// Steiner points added by insertions.
@@ -122,6 +126,7 @@ impl Cdt {
             judged: (plc.clone(), c.base),
             corners: Default::default(),
             split_log: None,
+            near: 1e-10 * crate::geom::diagonal(&plc.points),
             tets,
             stats: c.stats,
             warnings: c.warnings,
@@ -213,7 +218,7 @@ impl Cdt {
                 Location::Inside(t) => t,
             };
             self.check_budget()?;
-            let on = split::on_constraint(&self.tets, found, &p);
+            let on = split::on_constraint(&self.tets, found, &p, self.near);
             placed |= on.is_some();
             let step = match on {
                 Some(split::On::Subsegment(a, b)) => self.split_subsegment_at(a, b, p)?,

@@ -7,9 +7,9 @@ use super::{Cdt, InsertError, Tets};
 use crate::constrained::cdt::{edge_key, face_key};
 use crate::constrained::free;
 use crate::delaunay::Walled;
-use crate::geom::encroach::{circumcenter, in_diametral_ball, on_segment, on_triangle};
+use crate::geom::encroach::{circumcenter, in_diametral_ball, near_segment, near_triangle};
 use crate::geom::Point;
-use crate::mesh::{TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
+use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
 
 /// A constraint that a point lies on exactly.
 pub(super) enum On {
@@ -19,9 +19,9 @@ pub(super) enum On {
     Subface([VertexId; 3]),
 }
 
-/// The constraint of tet `t` (which holds `p`, possibly on its boundary) that `p` lies on
-/// exactly, if any.
-pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point) -> Option<On> {
+/// The constraint of tet `t` (which holds `p`, possibly on its boundary) that `p` lies on,
+/// exactly or within distance `tol` of it (see [`Cdt::build`]), if any.
+pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point, tol: f64) -> Option<On> {
     let v = tets.dt.mesh.verts(t);
     let pt = |x: VertexId| &tets.dt.points[x as usize];
     for &(i, j) in &EDGE_VERTS {
@@ -29,7 +29,7 @@ pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point) -> Option<On> {
         if a != GHOST
             && b != GHOST
             && tets.subsegs.contains_key(&edge_key(a, b))
-            && on_segment(pt(a), pt(b), p)
+            && near_segment(pt(a), pt(b), p, tol)
         {
             return Some(On::Subsegment(a, b));
         }
@@ -37,7 +37,8 @@ pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point) -> Option<On> {
     (0..4).find_map(|f| {
         let fv = FACE_VERTS[f].map(|k| v[k]);
         let is_sub = !fv.contains(&GHOST) && tets.subfaces.contains_key(&face_key(fv));
-        (is_sub && on_triangle(pt(fv[0]), pt(fv[1]), pt(fv[2]), p)).then_some(On::Subface(fv))
+        (is_sub && near_triangle(pt(fv[0]), pt(fv[1]), pt(fv[2]), p, tol))
+            .then_some(On::Subface(fv))
     })
 }
 
@@ -503,7 +504,7 @@ impl Cdt {
                 cdt.subsegs.insert(edge_key(a, b), k);
             }
         };
-        let settled = self.settle_split(m, (vertex, change, last), &made, undo_tables)?;
+        let settled = self.settle_split(m, (vertex, change, last), &made, &facets, undo_tables)?;
         if let (Ok(()), Some(_), Some((a, b)), Some(log)) =
             (&settled, marker, edge, &mut self.split_log)
         {
@@ -521,6 +522,7 @@ impl Cdt {
         m: Point,
         (vertex, change, last): (VertexId, crate::delaunay::Change, TetId),
         made: &[[VertexId; 3]],
+        facets: &[u32],
         undo_tables: impl Fn(&mut Tets),
     ) -> Result<Result<(), [VertexId; 3]>, InsertError> {
         let at = free::subsegment_ends(&self.tets);
@@ -533,7 +535,8 @@ impl Cdt {
             _ => None,
         };
         let ok = matches!(settled, free::Inserted::Yes { .. })
-            && made.iter().all(|s| self.tets.has_face(s[0], s[1], s[2]));
+            && made.iter().all(|s| self.tets.has_face(s[0], s[1], s[2]))
+            && !self.makes_shim(vertex, facets);
         if !ok {
             free::take_back(&mut self.tets, settled);
             undo_tables(&mut self.tets);
@@ -547,6 +550,84 @@ impl Cdt {
         Ok(Ok(()))
     }
 }
+
+impl Cdt {
+    /// Whether a tet around `v` (which lies on each of `facets`) has its other three
+    /// vertices on one of them too: a shim, flat within the facet, inside the domain.
+    fn makes_shim(&mut self, v: VertexId, facets: &[u32]) -> bool {
+        let mut star = Vec::new();
+        self.tets.dt.star(v, &mut star);
+        let mut on: rustc_hash::FxHashMap<VertexId, Vec<u32>> = Default::default();
+        let mut around = Vec::new();
+        for &t in &star {
+            for x in self.tets.dt.mesh.verts(t) {
+                if x == v || x == GHOST || on.contains_key(&x) {
+                    continue;
+                }
+                self.tets.dt.star(x, &mut around);
+                let mut fs: Vec<u32> = Vec::new();
+                for &u in &around {
+                    let w = self.tets.dt.mesh.verts(u);
+                    for fv in FACE_VERTS {
+                        let f = fv.map(|k| w[k]);
+                        if !f.contains(&x) || f.contains(&GHOST) {
+                            continue;
+                        }
+                        if let Some(&g) = self.tets.subfaces.get(&face_key(f)) {
+                            if facets.contains(&g) && !fs.contains(&g) {
+                                fs.push(g);
+                            }
+                        }
+                    }
+                }
+                on.insert(x, fs);
+            }
+        }
+        star.iter().any(|&t| {
+            let w = self.tets.dt.mesh.verts(t);
+            !w.contains(&GHOST)
+                && facets.iter().any(|g| {
+                    w.iter()
+                        .all(|x| *x == v || on.get(x).is_some_and(|fs| fs.contains(g)))
+                })
+                && !self.reaches_hull(t)
+        })
+    }
+
+    /// Whether tet `t` reaches the hull through faces that are no subfaces, within
+    /// [`EXTERIOR_SEARCH`] tets: then it lies outside the domain (a flat tet between a
+    /// facet that is not flat and the hull), and carving removes it. Interior tets never
+    /// do when the subfaces enclose the domain; the search stops early for them.
+    fn reaches_hull(&self, t: TetId) -> bool {
+        let mesh = &self.tets.dt.mesh;
+        let mut seen = vec![t];
+        let mut k = 0;
+        while k < seen.len() && seen.len() <= EXTERIOR_SEARCH {
+            let u = seen[k];
+            k += 1;
+            let w = mesh.verts(u);
+            for (f, fv) in FACE_VERTS.iter().enumerate() {
+                let face = face_key(fv.map(|i| w[i]));
+                if self.tets.subfaces.contains_key(&face) {
+                    continue;
+                }
+                let n = mesh.adj(FaceRef::new(u, f)).tet();
+                if mesh.is_ghost(n) {
+                    return true;
+                }
+                if !seen.contains(&n) {
+                    seen.push(n);
+                }
+            }
+        }
+        false
+    }
+}
+
+/// The most tets [`Cdt::reaches_hull`] visits: exterior flat tets lie in thin layers
+/// against the hull, a few tets deep; an interior tet would lead it through the whole
+/// domain.
+const EXTERIOR_SEARCH: usize = 64;
 
 /// Where a subface is split.
 enum FaceSplit {
