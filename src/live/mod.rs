@@ -206,12 +206,13 @@ impl Cdt {
         }
         let bound = self.split_bound();
         let mut splits = 0;
-        // Whether `p` itself split the constraint it lies on.
-        let mut placed = false;
+        // Vertices from here on are new: `p` itself may go in as a split point (of the
+        // constraint it lies on, or of one it encroaches upon whose split point it is).
+        let before = self.tets.dt.points.len();
         loop {
             let found = match self.tets.dt.locate_anywhere(&p) {
                 Location::Vertex(v) => {
-                    let new = placed && self.tets.dt.points[v as usize] == p;
+                    let new = v as usize >= before;
                     return Ok((v, new, splits - new as usize));
                 }
                 Location::Outside(_) => return Err(InsertError::OutsideHull(p)),
@@ -219,7 +220,6 @@ impl Cdt {
             };
             self.check_budget()?;
             let on = split::on_constraint(&self.tets, found, &p, self.near);
-            placed |= on.is_some();
             let step = match on {
                 Some(split::On::Subsegment(a, b)) => self.split_subsegment_at(a, b, p)?,
                 Some(split::On::Subface(f)) => self.split_subface_at(f, p)?,
