@@ -121,6 +121,20 @@ impl Cdt {
         self.find_face(a, b, c)
     }
 
+    /// Makes the triangles `tris` of facet `facet` that are mesh faces subfaces; the
+    /// others, missing, in their order.
+    pub fn keep_present(&mut self, tris: &[[VertexId; 3]], facet: u32) -> Vec<[VertexId; 3]> {
+        let mut missing = Vec::new();
+        for &t in tris {
+            if self.has_face(t[0], t[1], t[2]) {
+                self.subfaces.insert(face_key(t), facet);
+            } else {
+                missing.push(t);
+            }
+        }
+        missing
+    }
+
     /// Removes the subfaces among `at_risk` (drained) that are no longer mesh faces:
     /// they, with their facets, sorted.
     pub fn take_lost_subfaces(

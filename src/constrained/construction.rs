@@ -410,14 +410,7 @@ impl<'a> Construction<'a> {
         tris: &[[VertexId; 3]],
     ) -> Result<Option<FacetTris>, Error> {
         let normal = self.prep.facets[fi].normal;
-        let mut missing = Vec::new();
-        for t in tris {
-            if self.cdt.has_face(t[0], t[1], t[2]) {
-                self.cdt.subfaces.insert(face_key(*t), fi as u32);
-            } else {
-                missing.push(*t);
-            }
-        }
+        let missing = self.cdt.keep_present(tris, fi as u32);
         for region in regions_of(&missing, &self.seg_markers) {
             let stats = &mut *self.stats;
             let fallbacks = stats.flips.fallbacks;

@@ -274,14 +274,7 @@ impl Cdt {
             self.tets
                 .subfaces
                 .retain(|k, f| *f != fi || keys.contains(k));
-            let mut missing = Vec::new();
-            for &t in &tris {
-                if self.tets.has_face(t[0], t[1], t[2]) {
-                    self.tets.subfaces.insert(face_key(t), fi);
-                } else {
-                    missing.push(t);
-                }
-            }
+            let missing = self.tets.keep_present(&tris, fi);
             if missing.is_empty() {
                 // A flat tet with four vertices on the polygon (its corners and split
                 // points are not exactly coplanar) is a shim: the paper's remedy, a
@@ -385,14 +378,7 @@ impl Cdt {
                     }
                 })
                 .collect();
-            let mut missing = Vec::new();
-            for t in tris {
-                if self.tets.has_face(t[0], t[1], t[2]) {
-                    self.tets.subfaces.insert(face_key(t), g);
-                } else {
-                    missing.push(t);
-                }
-            }
+            let missing = self.tets.keep_present(&tris, g);
             for region in regions_of(&missing, &self.tets.subsegs) {
                 match self.insert_region(&region, g, normal)? {
                     Outcome::Inserted(rs) if rs.lost.is_empty() => {}
