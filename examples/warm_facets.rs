@@ -6,7 +6,8 @@
 //!
 //! usage: cargo run --release --example warm_facets -- MODEL.poly C|F|CF [RUNS]
 
-use tetcdt::constrained::{mesh_plc, FacetInserter, PlcOptions};
+use tetcdt::constrained::{FacetInserter, PlcOptions};
+use tetcdt::pipeline::mesh_plc;
 use tetcdt::plc::Plc;
 
 /// The facet recovery time of one run, in seconds.

@@ -1,214 +1,160 @@
-//! Carving: removing the tets outside the domain and in holes, and giving each remaining
-//! tet its region attribute. Floods never cross subfaces.
+//! Carving, the stage after facet recovery: the finished CDT's domain (the tets its
+//! subfaces enclose, with their regions) is kept and put in output form, with the
+//! subfaces and subsegments that bound it. It reads the CDT and changes nothing in it.
 
 use crate::constrained::cdt::Cdt;
-use crate::delaunay::Location;
-use crate::geom::Point;
-use crate::mesh::{FaceRef, TetId};
-use crate::plc::Region;
+use crate::constrained::construction::Built;
+use crate::constrained::domain::domain;
+use crate::constrained::{PlcOptions, PlcStats};
+use crate::error::Error;
+use crate::mesh::VertexId;
+use crate::output::MeshOut;
+use crate::plc::prepare::PreparedPlc;
+use crate::plc::Plc;
+use crate::progress::{Progress, Stage};
+use std::time::Instant;
 
-/// The tets that remain after carving, with their region attributes.
-#[derive(Clone, Debug, Default)]
-pub struct Carved {
-    /// The kept real tets.
-    pub tets: Vec<TetId>,
-    /// The region attribute of each kept tet (0 where no region point reaches).
-    pub attributes: Vec<f64>,
+/// Carves a copy of CDT `cdt` (whose subsegments are `seg_markers`) and puts it in
+/// output form.
+pub(crate) fn carve_copy(
+    plc: &Plc,
+    prep: &PreparedPlc,
+    cdt: &Cdt,
+    opts: &PlcOptions,
+    stats: &mut PlcStats,
+) -> Result<MeshOut, Error> {
+    let built = Built::of(cdt.clone(), cdt.subsegs.clone());
+    carve(plc, prep, built, opts, stats, &crate::progress::no_progress)
 }
 
-impl Carved {
-    /// Per tet slot (of `slots`), whether the tet is kept.
-    pub fn kept_mask(&self, slots: usize) -> Vec<bool> {
-        let mut kept = vec![false; slots];
-        for &t in &self.tets {
-            kept[t as usize] = true;
+/// Carves the CDT `built` of `plc` (meshed as `prep`): keeps the tets of its domain,
+/// gives them their regions, and puts the mesh in output form.
+pub(crate) fn carve(
+    plc: &Plc,
+    prep: &PreparedPlc,
+    built: Built,
+    opts: &PlcOptions,
+    stats: &mut PlcStats,
+    progress: Progress<'_>,
+) -> Result<MeshOut, Error> {
+    progress(Stage::Carve);
+    let Built {
+        mut cdt,
+        seg_markers,
+        carved,
+        flat_left: _,
+        retry_points: _,
+        first_point_covers: _,
+        covering: _,
+    } = built;
+    let t = Instant::now();
+    let carved =
+        carved.unwrap_or_else(|| domain(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull));
+    stats.carve_secs = t.elapsed().as_secs_f64();
+    if carved.tets.is_empty() {
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::empty_domain_message(plc),
         }
-        kept
+        .into());
     }
-}
-
-/// Carves the exterior (unless `keep_hull`), then the holes, and floods the regions.
-pub fn carve(cdt: &mut Cdt, holes: &[Point], regions: &[Region], keep_hull: bool) -> Carved {
-    let slots = cdt.dt.mesh.num_slots();
-    let mut removed = vec![false; slots];
-    let mut stack: Vec<TetId> = Vec::new();
-    for t in cdt.dt.mesh.live_tets().collect::<Vec<_>>() {
-        if cdt.is_ghost(t) {
-            removed[t as usize] = true;
-            if !keep_hull && !cdt.is_subface(t, 3) {
-                stack.push(cdt.dt.mesh.adj(FaceRef::new(t, 3)).tet());
-            }
-        }
-    }
-    flood(cdt, &mut stack, &mut removed);
-    for h in holes {
-        if let Some(t) = containing_tet(cdt, h) {
-            if !removed[t as usize] {
-                stack.push(t);
-                flood(cdt, &mut stack, &mut removed);
-            }
-        }
-    }
-    let mut attr = vec![0.0f64; slots];
-    let mut seen = vec![false; slots];
-    for r in regions {
-        let Some(t) = containing_tet(cdt, &r.point) else {
-            continue;
-        };
-        if removed[t as usize] {
-            continue;
-        }
-        // Each region floods from scratch, so a later region point inside an earlier
-        // region's tets takes them over, as TetGen does.
-        seen.iter_mut().for_each(|s| *s = false);
-        stack.push(t);
-        seen[t as usize] = true;
-        while let Some(t) = stack.pop() {
-            attr[t as usize] = r.attribute;
-            for i in 0..4 {
-                if cdt.is_subface(t, i) {
-                    continue;
-                }
-                let n = cdt.dt.mesh.adj(FaceRef::new(t, i)).tet();
-                if !removed[n as usize] && !seen[n as usize] {
-                    seen[n as usize] = true;
-                    stack.push(n);
-                }
-            }
-        }
-    }
-    let tets: Vec<TetId> = cdt
+    let n_out = cdt
         .dt
-        .mesh
-        .real_tets()
-        .filter(|&t| !removed[t as usize])
+        .orig
+        .iter()
+        .map(|&o| o as usize + 1)
+        .max()
+        .unwrap_or(0)
+        .max(plc.points.len());
+    let mut points = plc.points.clone();
+    points.resize(n_out, [0.0; 3]);
+    for (v, &o) in cdt.dt.orig.iter().enumerate() {
+        points[o as usize] = cdt.dt.points[v];
+    }
+    let orig_ids = cdt.dt.orig.clone();
+    let orig = |v: VertexId| orig_ids[v as usize];
+    let mut kept = vec![false; cdt.dt.mesh.num_slots()];
+    for &t in &carved.tets {
+        kept[t as usize] = true;
+    }
+    let tets: Vec<[u32; 4]> = carved
+        .tets
+        .iter()
+        .map(|&t| cdt.dt.mesh.verts(t).map(orig))
         .collect();
-    let attributes = tets.iter().map(|&t| attr[t as usize]).collect();
-    Carved { tets, attributes }
-}
-
-/// Marks as removed everything reachable from `stack` without crossing a subface.
-fn flood(cdt: &Cdt, stack: &mut Vec<TetId>, removed: &mut [bool]) {
-    while let Some(t) = stack.pop() {
-        if removed[t as usize] {
+    // Each subface is found through the face index's hint (a walk only where the mesh
+    // changed since), and written from a kept side: from the lower tet if both are kept.
+    let mut keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
+    keys.sort_unstable();
+    let mut subfaces: Vec<([u32; 3], i32)> = Vec::with_capacity(keys.len());
+    for (k, f) in keys {
+        let Some(a) = cdt.face_ref(k[0], k[1], k[2]) else {
             continue;
-        }
-        removed[t as usize] = true;
-        for i in 0..4 {
-            // The cheap test first: most faces of a flood lead back to removed tets.
-            let n = cdt.dt.mesh.adj(FaceRef::new(t, i)).tet();
-            if !removed[n as usize] && !cdt.is_subface(t, i) {
-                stack.push(n);
-            }
-        }
-    }
-}
-
-/// The real tet containing point `p`, if it lies inside the hull.
-pub(crate) fn containing_tet(cdt: &mut Cdt, p: &Point) -> Option<TetId> {
-    match cdt.dt.locate_anywhere(p) {
-        Location::Inside(t) => Some(t),
-        Location::Vertex(v) => cdt.dt.mesh.vertex_tet(v).filter(|&t| !cdt.is_ghost(t)),
-        Location::Outside(_) => None,
-    }
-}
-
-/// [`containing_tet`], searching from tet `near`.
-pub(crate) fn containing_tet_near(cdt: &mut Cdt, near: TetId, p: &Point) -> Option<TetId> {
-    match cdt.dt.locate_anywhere_from(near, p) {
-        Location::Inside(t) => Some(t),
-        Location::Vertex(v) => cdt.dt.mesh.vertex_tet(v).filter(|&t| !cdt.is_ghost(t)),
-        Location::Outside(_) => None,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::constrained::cdt::face_key;
-    use crate::delaunay::Delaunay;
-
-    /// Two unit cubes side by side; the faces of the left cube are subfaces.
-    fn two_cubes() -> Cdt {
-        let mut pts = Vec::new();
-        for x in 0..3 {
-            for y in 0..2 {
-                for z in 0..2 {
-                    pts.push([x as f64, y as f64, z as f64]);
-                }
-            }
-        }
-        let mut cdt = Cdt::new(Delaunay::build(&pts).unwrap().dt);
-        // Subfaces: every face of the mesh lying on the boundary of the left cube [0,1]^3.
-        let p = cdt.dt.points.clone();
-        let on_left_boundary = |f: [u32; 3]| {
-            let q = f.map(|v| p[v as usize]);
-            (0..3).any(|k| {
-                (q.iter().all(|x| x[k] == 0.0) || q.iter().all(|x| x[k] == 1.0))
-                    && q.iter().all(|x| x[0] <= 1.0)
-            })
         };
-        let tets: Vec<_> = cdt.dt.mesh.real_tets().collect();
-        for t in tets {
-            for i in 0..4 {
-                let f = cdt.dt.mesh.face_verts(t, i);
-                if on_left_boundary(f) {
-                    cdt.subfaces.insert(face_key(f), 0);
-                }
-            }
-        }
-        cdt
-    }
-
-    fn volume(cdt: &Cdt, tets: &[TetId]) -> f64 {
-        tets.iter()
-            .map(|&t| {
-                let v = cdt.dt.mesh.verts(t).map(|x| cdt.dt.points[x as usize]);
-                crate::geom::orient3d(&v[0], &v[1], &v[2], &v[3]) / 6.0
-            })
-            .sum()
-    }
-
-    #[test]
-    fn the_exterior_is_removed_up_to_subfaces() {
-        let mut cdt = two_cubes();
-        let c = carve(&mut cdt, &[], &[], false);
-        assert!((volume(&cdt, &c.tets) - 1.0).abs() < 1e-12);
-        // Every kept tet lies in the left cube.
-        for &t in &c.tets {
-            assert!(cdt
-                .dt
-                .mesh
-                .verts(t)
-                .iter()
-                .all(|&v| cdt.dt.points[v as usize][0] <= 1.0));
-        }
-    }
-
-    #[test]
-    fn holes_regions_and_the_kept_hull() {
-        let mut cdt = two_cubes();
-        let c = carve(&mut cdt, &[], &[], true);
-        assert!((volume(&cdt, &c.tets) - 2.0).abs() < 1e-12);
-        let c = carve(&mut cdt, &[[0.5, 0.5, 0.5]], &[], true);
-        assert!(
-            (volume(&cdt, &c.tets) - 1.0).abs() < 1e-12,
-            "the hole empties the left cube"
-        );
-        let region = |x: f64, a: f64| Region {
-            point: [x, 0.5, 0.5],
-            attribute: a,
-            max_volume: -1.0,
+        let b = cdt.dt.mesh.adj(a);
+        let side = match (kept[a.tet() as usize], kept[b.tet() as usize]) {
+            (true, true) if b.tet() < a.tet() => b,
+            (true, _) => a,
+            (false, true) => b,
+            (false, false) => continue,
         };
-        let c = carve(&mut cdt, &[], &[region(0.5, 7.0), region(1.5, -2.0)], true);
-        for (&t, &a) in c.tets.iter().zip(&c.attributes) {
-            let left = cdt
-                .dt
-                .mesh
-                .verts(t)
-                .iter()
-                .all(|&v| cdt.dt.points[v as usize][0] <= 1.0);
-            assert_eq!(a, if left { 7.0 } else { -2.0 });
-        }
+        // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
+        let w = cdt.dt.mesh.face_verts(side.tet(), side.face()).map(orig);
+        subfaces.push((w, prep.facets[f as usize].marker));
     }
+    let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
+        .iter()
+        .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
+        .collect();
+    subsegments.sort_unstable();
+    // A polygon dangling in the exterior (a fin on a surface) would be carved away with
+    // it: its edges would bound no tet, and the mesh would silently lose a constraint.
+    // One pass over the tets marks the subsegments found.
+    let mut listed =
+        crate::mesh::ListedEdges::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
+    listed.mark(tets.iter().copied());
+    // `subsegments` is sorted: the flags are in its order.
+    let found_edge = listed.flags();
+    let lost = found_edge.iter().filter(|&&f| !f).count();
+    if let Some(k) = found_edge.iter().position(|&f| !f) {
+        let [a, b] = subsegments[k].0;
+        let name = |v: u32| v as usize + plc.first_index;
+        return Err(crate::error::InputError::Invalid {
+            file: plc.source.clone(),
+            msg: crate::precheck::exterior_polygon_message(plc, lost, (name(a), name(b))),
+        }
+        .into());
+    }
+    stats.output_tets = tets.len();
+    stats.output_subfaces = subfaces.len();
+    let n_attr = plc.num_point_attrs;
+    let mut point_attrs = plc.point_attrs.clone();
+    point_attrs.resize(n_out * n_attr, 0.0);
+    let point_markers = plc.point_markers.clone().map(|mut m| {
+        m.resize(n_out, 0);
+        m
+    });
+    let (num_tet_attrs, tet_attrs) = if opts.region_attributes {
+        (1, carved.attributes)
+    } else {
+        (0, Vec::new())
+    };
+    let mesh = MeshOut {
+        points,
+        num_point_attrs: n_attr,
+        point_attrs,
+        point_markers,
+        tets,
+        neighbors: Vec::new(),
+        num_tet_attrs,
+        tet_attrs,
+        subfaces,
+        subsegments,
+        plc_mode: true,
+        subfaces_oriented: true,
+        first_index: plc.first_index,
+        convex_hull_kept: opts.keep_hull,
+        ..Default::default()
+    };
+    Ok(mesh)
 }

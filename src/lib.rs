@@ -75,7 +75,7 @@ pub fn tetrahedralize_with_progress(
     pipeline::run(plc, opts, progress)
 }
 
-mod pipeline;
+pub mod pipeline;
 
 /// The number of cores this process may use, read once: each reading costs a dozen
 /// system calls (cgroup files), a noticeable share of a small model's run.

@@ -1,9 +1,13 @@
 //! The meshing pipeline: read model → Delaunay → (segments → facets → carve) → output.
+//! [`mesh_plc`] is the `-p` part: [`crate::constrained`] builds the CDT, [`crate::carve`]
+//! keeps its domain.
 
+use crate::constrained::{construct, Constructed, PlcOptions, PlcStats};
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
 use crate::options::Options;
 use crate::output::MeshOut;
+use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
 use crate::stats::Stats;
@@ -116,7 +120,7 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             wake_when_prepared: Some(checker.thread().clone()),
             ..popts
         };
-        let done = crate::constrained::mesh_plc_with_progress(plc, &popts, progress);
+        let done = mesh_plc_with_progress(plc, &popts, progress);
         checker.thread().unpark();
         let checked = checker
             .join()
@@ -155,5 +159,46 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
         mesh: done.mesh,
         stats,
         warnings,
+    })
+}
+
+/// The finished PLC mesh, its figures, and warnings for the user.
+pub struct PlcMesh {
+    /// The mesh in output form.
+    pub mesh: MeshOut,
+    /// Figures.
+    pub stats: PlcStats,
+    /// Warnings.
+    pub warnings: Vec<String>,
+    /// The PLC as prepared for meshing (merged facets, segments), which the certifier
+    /// judges the mesh against.
+    pub prepared: PreparedPlc,
+}
+
+/// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
+pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
+    mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
+}
+
+/// Like [`mesh_plc`], telling `progress` when each stage begins.
+pub fn mesh_plc_with_progress(
+    plc: &Plc,
+    opts: &PlcOptions,
+    progress: Progress<'_>,
+) -> Result<PlcMesh, Error> {
+    let Constructed {
+        built,
+        split,
+        base,
+        mut stats,
+        warnings,
+    } = construct(plc, opts, progress)?;
+    let prep = split.as_ref().unwrap_or(&base);
+    let mesh = crate::carve::carve(plc, prep, *built, opts, &mut stats, progress)?;
+    Ok(PlcMesh {
+        mesh,
+        stats,
+        warnings,
+        prepared: base,
     })
 }

@@ -6,6 +6,7 @@
 
 use super::cavity::Outcome;
 use super::cdt::{edge_key, face_key, triangles_by_edge, Cdt};
+use super::domain::{domain, Domain};
 use super::in_place::{
     for_each_facet_segment, insert_free_unrecovering, insert_unrecovered, midpoint_parameter,
     split_encroached, FreeInPlace, Segs, MAX_IN_PLACE, MAX_IN_PLACE_EACH,
@@ -14,7 +15,6 @@ use super::{
     debug, free, max_facet_points, restart_work_bound, segments, slivers, FacetContext, FacetPoint,
     FacetTris, PlcOptions, PlcStats, SegmentSplit, FREE_POINT, RESTART_WORK,
 };
-use crate::carve::{carve, Carved};
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
 use crate::geom::Point;
@@ -62,7 +62,7 @@ pub(crate) struct Built {
     /// The subsegments with their markers.
     pub seg_markers: FxHashMap<(VertexId, VertexId), i32>,
     /// The CDT's carving, if one was made since it last changed.
-    pub carved: Option<Carved>,
+    pub carved: Option<Domain>,
     /// The tets left with all four vertices on one facet (of the all-merged facets).
     pub flat_left: slivers::OnFacets,
     /// When a few tets are left on facets: points for another construction that may
@@ -215,7 +215,7 @@ struct Construction<'a> {
     free_rounds: usize,
     budget: Option<u64>,
     /// The carving of the CDT as it stands, while nothing changes it.
-    carved: Option<Carved>,
+    carved: Option<Domain>,
     /// The flat tets left on facets, when known (`None` after points went in).
     flat_left: Option<slivers::OnFacets>,
     /// The work of the construction before its free points (their search is bounded
@@ -964,7 +964,7 @@ fn flat_tet_search<'a>(
     slivers::Search {
         prep: merged,
         input: &plc.points,
-        domain: slivers::Domain {
+        domain: slivers::DomainOf {
             holes: &plc.holes,
             regions: &plc.regions,
             keep_hull: opts.keep_hull,
@@ -1052,7 +1052,7 @@ pub(super) fn resolve_shims(
     cdt: &mut Cdt,
     plc: &Plc,
     opts: &PlcOptions,
-) -> (Vec<(usize, Point)>, Option<Carved>) {
+) -> (Vec<(usize, Point)>, Option<Domain>) {
     // A shim has four vertices on one facet, and facets of three vertices have none:
     // each vertex lists the facets of more than one subface it is on. These short lists
     // rule out most tets without looking up their faces. (Swaps below exchange a shim's
@@ -1077,7 +1077,7 @@ pub(super) fn resolve_shims(
         crate::mesh::VertexLists::new(cdt.dt.points.len(), pairs.into_iter())
     };
     let on_facet = |x: VertexId, f: u32| on.of(x).contains(&f);
-    let mut carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
+    let mut carved = domain(cdt, &plc.holes, &plc.regions, opts.keep_hull);
     for _round in 0..64 {
         let kept = carved.kept_mask(cdt.dt.mesh.num_slots());
         let mut swapped: Vec<crate::mesh::TetId> = Vec::new();
@@ -1164,11 +1164,11 @@ pub(super) fn resolve_shims(
             carved.attributes = vec![0.0; carved.tets.len()];
             debug_assert_eq!(
                 carved.tets,
-                carve(cdt, &plc.holes, &plc.regions, opts.keep_hull).tets,
+                domain(cdt, &plc.holes, &plc.regions, opts.keep_hull).tets,
                 "a shim swap changed the carving beyond its shim"
             );
         } else {
-            carved = carve(cdt, &plc.holes, &plc.regions, opts.keep_hull);
+            carved = domain(cdt, &plc.holes, &plc.regions, opts.keep_hull);
         }
     }
     (Vec::new(), None)

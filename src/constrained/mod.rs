@@ -1,7 +1,8 @@
 //! Constrained Delaunay tetrahedralization of a PLC: preparation of the PLC, segment
-//! recovery with Steiner points, and facet insertion, then carving.
+//! recovery with Steiner points, and facet insertion; [`crate::carve`] then keeps its
+//! domain.
 //!
-//! [`mesh_plc`] runs read PLC → Delaunay → segments → facets → carve, one construction
+//! `construct` runs Delaunay → segments → facets, one construction
 //! (`construction.rs`) after another. When a polygon that is not flat needs a Steiner
 //! point on it (paper §3.1), the point goes into the CDT by a walled cavity and flips
 //! (`free.rs`) and the polygon is triangulated again with it, or the CDT is updated in
@@ -12,8 +13,8 @@ mod bistellar;
 pub mod cavity;
 pub mod cdt;
 pub(crate) mod construction;
+pub(crate) mod domain;
 pub mod enclosure;
-pub mod facet2d;
 pub mod flip;
 mod flip_queue;
 pub(crate) mod free;
@@ -23,12 +24,10 @@ mod slivers;
 
 pub(crate) use construction::regions_of;
 
-use crate::carve::carve;
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
-use crate::geom::Point;
+use crate::geom::{facet2d, Point};
 use crate::mesh::VertexId;
-use crate::output::MeshOut;
 use crate::plc::prepare::{self, prepare, PreparedPlc};
 use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
@@ -192,19 +191,6 @@ pub struct PlcStats {
     pub flip_fallback_facets: Vec<u32>,
 }
 
-/// The finished PLC mesh, its figures, and warnings for the user.
-pub struct PlcMesh {
-    /// The mesh in output form.
-    pub mesh: MeshOut,
-    /// Figures.
-    pub stats: PlcStats,
-    /// Warnings.
-    pub warnings: Vec<String>,
-    /// The PLC as prepared for meshing (merged facets, segments), which the certifier
-    /// judges the mesh against.
-    pub prepared: PreparedPlc,
-}
-
 /// Whether to trace restarts, Steiner points, cavity widening and flip fallbacks on
 /// stderr (`TETCDT_DEBUG=1`).
 fn debug() -> bool {
@@ -253,35 +239,7 @@ fn without_updates(stats0: &PlcStats) -> (Vec<FacetPoint>, Vec<SegmentSplit>, u6
     (Vec::new(), Vec::new(), 0, stats)
 }
 
-/// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
-pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
-    mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
-}
-
-/// Like [`mesh_plc`], telling `progress` when each stage (of each attempt) begins.
-pub fn mesh_plc_with_progress(
-    plc: &Plc,
-    opts: &PlcOptions,
-    progress: Progress<'_>,
-) -> Result<PlcMesh, Error> {
-    let Constructed {
-        built,
-        split,
-        base,
-        mut stats,
-        warnings,
-    } = construct(plc, opts, progress)?;
-    let prep = split.as_ref().unwrap_or(&base);
-    let mesh = finish(plc, prep, *built, opts, &mut stats, progress)?;
-    Ok(PlcMesh {
-        mesh,
-        stats,
-        warnings,
-        prepared: base,
-    })
-}
-
-/// A finished CDT of a PLC before carving: what [`mesh_plc`] carves, and what
+/// A finished CDT of a PLC before carving: what [`crate::pipeline::mesh_plc`] carves, and what
 /// [`crate::live::Cdt`] keeps to insert into.
 pub(crate) struct Constructed {
     /// The CDT.
@@ -993,150 +951,6 @@ fn facet_name(plc: &Plc, f: &prepare::MergedFacet) -> String {
     }
 }
 
-/// Carves a copy of CDT `cdt` (whose subsegments are `seg_markers`) and puts it in
-/// output form.
-pub(crate) fn carve_copy(
-    plc: &Plc,
-    prep: &PreparedPlc,
-    cdt: &Cdt,
-    opts: &PlcOptions,
-    stats: &mut PlcStats,
-) -> Result<MeshOut, Error> {
-    let built = Built::of(cdt.clone(), cdt.subsegs.clone());
-    finish(plc, prep, built, opts, stats, &crate::progress::no_progress)
-}
-
-/// Carves the mesh and puts it in output form.
-fn finish(
-    plc: &Plc,
-    prep: &PreparedPlc,
-    built: Built,
-    opts: &PlcOptions,
-    stats: &mut PlcStats,
-    progress: Progress<'_>,
-) -> Result<MeshOut, Error> {
-    progress(Stage::Carve);
-    let Built {
-        mut cdt,
-        seg_markers,
-        carved,
-        flat_left: _,
-        retry_points: _,
-        first_point_covers: _,
-        covering: _,
-    } = built;
-    let t = Instant::now();
-    let carved =
-        carved.unwrap_or_else(|| carve(&mut cdt, &plc.holes, &plc.regions, opts.keep_hull));
-    stats.carve_secs = t.elapsed().as_secs_f64();
-    if carved.tets.is_empty() {
-        return Err(crate::error::InputError::Invalid {
-            file: plc.source.clone(),
-            msg: crate::precheck::empty_domain_message(plc),
-        }
-        .into());
-    }
-    let n_out = cdt
-        .dt
-        .orig
-        .iter()
-        .map(|&o| o as usize + 1)
-        .max()
-        .unwrap_or(0)
-        .max(plc.points.len());
-    let mut points = plc.points.clone();
-    points.resize(n_out, [0.0; 3]);
-    for (v, &o) in cdt.dt.orig.iter().enumerate() {
-        points[o as usize] = cdt.dt.points[v];
-    }
-    let orig_ids = cdt.dt.orig.clone();
-    let orig = |v: VertexId| orig_ids[v as usize];
-    let mut kept = vec![false; cdt.dt.mesh.num_slots()];
-    for &t in &carved.tets {
-        kept[t as usize] = true;
-    }
-    let tets: Vec<[u32; 4]> = carved
-        .tets
-        .iter()
-        .map(|&t| cdt.dt.mesh.verts(t).map(orig))
-        .collect();
-    // Each subface is found through the face index's hint (a walk only where the mesh
-    // changed since), and written from a kept side: from the lower tet if both are kept.
-    let mut keys: Vec<([VertexId; 3], u32)> = cdt.subfaces.iter().map(|(k, &f)| (*k, f)).collect();
-    keys.sort_unstable();
-    let mut subfaces: Vec<([u32; 3], i32)> = Vec::with_capacity(keys.len());
-    for (k, f) in keys {
-        let Some(a) = cdt.face_ref(k[0], k[1], k[2]) else {
-            continue;
-        };
-        let b = cdt.dt.mesh.adj(a);
-        let side = match (kept[a.tet() as usize], kept[b.tet() as usize]) {
-            (true, true) if b.tet() < a.tet() => b,
-            (true, _) => a,
-            (false, true) => b,
-            (false, false) => continue,
-        };
-        // Seen from the kept tet, as TetGen orients subfaces: they face into the mesh.
-        let w = cdt.dt.mesh.face_verts(side.tet(), side.face()).map(orig);
-        subfaces.push((w, prep.facets[f as usize].marker));
-    }
-    let mut subsegments: Vec<([u32; 2], i32)> = seg_markers
-        .iter()
-        .map(|(&(a, b), &m)| ([orig(a).min(orig(b)), orig(a).max(orig(b))], m))
-        .collect();
-    subsegments.sort_unstable();
-    // A polygon dangling in the exterior (a fin on a surface) would be carved away with
-    // it: its edges would bound no tet, and the mesh would silently lose a constraint.
-    // One pass over the tets marks the subsegments found.
-    let mut listed =
-        crate::mesh::ListedEdges::new(n_out, subsegments.iter().map(|&([a, b], _)| (a, b)));
-    listed.mark(tets.iter().copied());
-    // `subsegments` is sorted: the flags are in its order.
-    let found_edge = listed.flags();
-    let lost = found_edge.iter().filter(|&&f| !f).count();
-    if let Some(k) = found_edge.iter().position(|&f| !f) {
-        let [a, b] = subsegments[k].0;
-        let name = |v: u32| v as usize + plc.first_index;
-        return Err(crate::error::InputError::Invalid {
-            file: plc.source.clone(),
-            msg: crate::precheck::exterior_polygon_message(plc, lost, (name(a), name(b))),
-        }
-        .into());
-    }
-    stats.output_tets = tets.len();
-    stats.output_subfaces = subfaces.len();
-    let n_attr = plc.num_point_attrs;
-    let mut point_attrs = plc.point_attrs.clone();
-    point_attrs.resize(n_out * n_attr, 0.0);
-    let point_markers = plc.point_markers.clone().map(|mut m| {
-        m.resize(n_out, 0);
-        m
-    });
-    let (num_tet_attrs, tet_attrs) = if opts.region_attributes {
-        (1, carved.attributes)
-    } else {
-        (0, Vec::new())
-    };
-    let mesh = MeshOut {
-        points,
-        num_point_attrs: n_attr,
-        point_attrs,
-        point_markers,
-        tets,
-        neighbors: Vec::new(),
-        num_tet_attrs,
-        tet_attrs,
-        subfaces,
-        subsegments,
-        plc_mode: true,
-        subfaces_oriented: true,
-        first_index: plc.first_index,
-        convex_hull_kept: opts.keep_hull,
-        ..Default::default()
-    };
-    Ok(mesh)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1185,9 +999,9 @@ mod tests {
             wake_when_prepared: None,
             ..Default::default()
         };
-        assert!(mesh_plc(&plc, &opts).is_ok());
+        assert!(crate::pipeline::mesh_plc(&plc, &opts).is_ok());
         flag.store(true, Ordering::Relaxed);
-        match mesh_plc(&plc, &opts) {
+        match crate::pipeline::mesh_plc(&plc, &opts) {
             Err(Error::Mesh(MeshError::Failed(m))) => assert_eq!(m, CANCELLED),
             Err(e) => panic!("unexpected error {e}"),
             Ok(_) => panic!("a cancelled run meshed"),

@@ -7,7 +7,7 @@
 //! the domain, removes the tet from the CDT instead.
 
 use super::cdt::Cdt;
-use crate::carve::{carve, containing_tet_near, Carved};
+use super::domain::{containing_tet_near, domain, Domain};
 use crate::geom::bvh::{Aabb, Bvh};
 use crate::geom::polygon::newell_normal;
 use crate::geom::predicates::{insphere, orient3d};
@@ -43,8 +43,8 @@ impl Slab {
     }
 }
 
-/// The domain that carving leaves, as [`carve`] needs it.
-pub(crate) struct Domain<'a> {
+/// What a CDT's domain is made of besides its subfaces, as [`domain`] needs it.
+pub(crate) struct DomainOf<'a> {
     pub holes: &'a [Point],
     pub regions: &'a [Region],
     pub keep_hull: bool,
@@ -55,7 +55,7 @@ pub(crate) struct Domain<'a> {
 pub(crate) struct Search<'a> {
     pub prep: &'a PreparedPlc,
     pub input: &'a [Point],
-    pub domain: Domain<'a>,
+    pub domain: DomainOf<'a>,
     /// Which facets each input vertex is on, and the facets' slabs: made when first
     /// needed (a model without Steiner points never needs them).
     pub index: OnceCell<FacetIndex>,
@@ -369,7 +369,7 @@ struct Found {
 /// ones, and thick ones squashed within the slab of a facet that bends (their faces
 /// would lie on the facet beside its triangles); `None` if there are none. `carved` is
 /// the CDT's carving if known, and is set if made.
-fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) -> Option<Found> {
+fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Domain>) -> Option<Found> {
     let Search { prep, input, .. } = search;
     // A tet can lie on one facet only if it has a Steiner point (which may lie in a
     // slab), or if its four input vertices share a facet, which then has four or more:
@@ -422,7 +422,7 @@ fn find_flat(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
 pub(crate) fn flat_left(
     cdt: &mut Cdt,
     search: &Search<'_>,
-    carved: &mut Option<Carved>,
+    carved: &mut Option<Domain>,
     max_retry: usize,
 ) -> (OnFacets, Vec<Point>) {
     let Some(found) = find_flat(cdt, search, carved) else {
@@ -439,10 +439,10 @@ pub(crate) fn flat_left(
 
 /// Which tet slots carving keeps; `carved` is the CDT's carving if known, and is set if
 /// made.
-fn kept_mask(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) -> Vec<bool> {
+fn kept_mask(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Domain>) -> Vec<bool> {
     carved
         .get_or_insert_with(|| {
-            carve(
+            domain(
                 cdt,
                 search.domain.holes,
                 search.domain.regions,
@@ -460,7 +460,7 @@ fn kept_mask(cdt: &mut Cdt, search: &Search<'_>, carved: &mut Option<Carved>) ->
 pub(crate) fn covering_flat_tets(
     cdt: &mut Cdt,
     search: &Search<'_>,
-    carved: &mut Option<Carved>,
+    carved: &mut Option<Domain>,
 ) -> Vec<[VertexId; 4]> {
     let kept = kept_mask(cdt, search, carved);
     let n_input = search.input.len();
@@ -492,7 +492,7 @@ pub(crate) fn covering_flat_tets(
 pub(crate) fn free_points(
     cdt: &mut Cdt,
     search: &Search<'_>,
-    carved: &mut Option<Carved>,
+    carved: &mut Option<Domain>,
     budget: &mut u64,
 ) -> FlatTets {
     let Some(Found { tets, kept }) = find_flat(cdt, search, carved) else {
@@ -868,7 +868,7 @@ mod tests {
         let search = Search {
             prep: &prep,
             input: &plc.points,
-            domain: Domain {
+            domain: DomainOf {
                 holes: &[],
                 regions: &[],
                 keep_hull: false,
@@ -924,7 +924,7 @@ mod tests {
         let search = Search {
             prep: &prep,
             input: &plc.points,
-            domain: Domain {
+            domain: DomainOf {
                 holes: &[],
                 regions: &[],
                 keep_hull: false,

@@ -3,6 +3,7 @@
 pub mod bvh;
 pub mod encroach;
 pub mod expansion;
+pub mod facet2d;
 pub mod fixed;
 pub mod hilbert;
 pub mod lifted;

@@ -3,6 +3,7 @@
 //! before meshing and the certifier, so that all three see a polygon the same way.
 
 use super::Point;
+use rustc_hash::FxHashMap;
 
 /// Drops repeated consecutive vertices, also across the wrap.
 pub fn dedup_ring(poly: &[u32]) -> Vec<u32> {
@@ -174,6 +175,29 @@ pub enum RingSide {
     Boundary,
     /// Strictly outside.
     Outside,
+}
+
+/// For each point, the lowest-indexed point with exactly equal coordinates.
+pub fn representatives(points: &[Point]) -> Vec<u32> {
+    let mut first: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    first.reserve(points.len());
+    points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            // Adding 0.0 turns -0.0 into 0.0, which compares equal to it.
+            *first
+                .entry(p.map(|v| (v + 0.0).to_bits()))
+                .or_insert(i as u32)
+        })
+        .collect()
+}
+
+/// Polygon `poly` with its vertices replaced by their representatives `rep`, without
+/// repeated consecutive vertices (also across the wrap).
+pub fn clean_ring(poly: &[u32], rep: &[u32]) -> Vec<u32> {
+    let mapped: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
+    dedup_ring(&mapped)
 }
 
 #[cfg(test)]

@@ -29,7 +29,7 @@ pub fn read_plc(path: &Path) -> Result<Plc, InputError> {
     // that exact welding collapses; those add nothing to the surface and are dropped.
     let surface = |plc: Result<Plc, InputError>| {
         plc.map(|mut p| {
-            crate::precheck::drop_degenerate_polygons(&mut p);
+            p.drop_degenerate_polygons();
             p
         })
     };

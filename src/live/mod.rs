@@ -168,7 +168,7 @@ impl Cdt {
     /// The mesh, carved, in output form.
     pub fn mesh(&self) -> Result<MeshOut, Error> {
         let mut stats = self.stats.clone();
-        crate::constrained::carve_copy(&self.plc, &self.meshed, &self.tets, &self.opts, &mut stats)
+        crate::carve::carve_copy(&self.plc, &self.meshed, &self.tets, &self.opts, &mut stats)
     }
 
     /// Certifies the carved mesh as a CDT of the PLC ([`crate::check`]).

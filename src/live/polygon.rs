@@ -9,7 +9,8 @@
 use super::{Cdt, InsertError, Tets};
 use crate::constrained::cavity::Outcome;
 use crate::constrained::cdt::{edge_key, face_key};
-use crate::constrained::{facet2d, regions_of};
+use crate::constrained::regions_of;
+use crate::geom::facet2d;
 use crate::geom::polygon::{newell_normal, Projection};
 use crate::geom::Point;
 use crate::mesh::VertexId;

@@ -3,6 +3,7 @@
 
 pub mod prepare;
 
+use crate::geom::polygon::{clean_ring, representatives};
 use std::path::PathBuf;
 
 /// One facet: a set of polygons (possibly 1- or 2-vertex ones) lying in a common plane,
@@ -57,6 +58,18 @@ pub struct Plc {
     pub warnings: Vec<String>,
 }
 
+/// How many offending elements a message lists before "and N more".
+pub(crate) const SHOWN: usize = 5;
+
+/// "; and N more" when a list was cut.
+pub(crate) fn more(total: usize) -> String {
+    if total > SHOWN {
+        format!("; and {} more", total - SHOWN)
+    } else {
+        String::new()
+    }
+}
+
 impl Plc {
     /// Returns a PLC with only the given points, numbered from `first_index`.
     pub fn from_points(points: Vec<[f64; 3]>, first_index: usize) -> Self {
@@ -65,5 +78,49 @@ impl Plc {
             first_index,
             ..Default::default()
         }
+    }
+
+    /// A facet's name in messages: its number as in the file, and its line when known.
+    pub fn facet_name(&self, fi: usize) -> String {
+        match self.facets.get(fi).map(|f| f.line).unwrap_or(0) {
+            0 => format!("facet {}", fi + self.first_index),
+            line => format!("facet {} (line {line})", fi + self.first_index),
+        }
+    }
+
+    /// Drops the polygons of a surface mesh that have fewer than three distinct corners once
+    /// exactly equal points are welded (two corners at one point): they add nothing to the
+    /// surface. One warning counts them and names the first few. Polygons with an index out
+    /// of range are left for [`crate::precheck::check_elements`] to report.
+    pub fn drop_degenerate_polygons(&mut self) {
+        let rep = representatives(&self.points);
+        let n = self.points.len();
+        let mut dropped: Vec<usize> = Vec::new();
+        for (fi, f) in self.facets.iter_mut().enumerate() {
+            let before = f.polygons.len();
+            f.polygons.retain(|poly| {
+                poly.len() < 3
+                    || poly.iter().any(|&v| v as usize >= n)
+                    || clean_ring(poly, &rep).len() >= 3
+            });
+            if f.polygons.len() < before {
+                dropped.push(fi);
+            }
+        }
+        if dropped.is_empty() {
+            return;
+        }
+        let list: Vec<String> = dropped
+            .iter()
+            .take(SHOWN)
+            .map(|&fi| self.facet_name(fi))
+            .collect();
+        self.warnings.push(format!(
+            "{} facet(s) with a repeated corner (two corners at the same point) add nothing to \
+             the surface and were dropped: {}{}",
+            dropped.len(),
+            list.join(", "),
+            more(dropped.len())
+        ));
     }
 }

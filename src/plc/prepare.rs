@@ -17,6 +17,7 @@
 
 use crate::error::InputError;
 use crate::geom::norm;
+use crate::geom::polygon::representatives;
 pub(crate) use crate::geom::polygon::{all_collinear, dedup_ring, newell_normal};
 use crate::geom::polygon::{Projection, RingSide};
 use crate::plc::Plc;
@@ -152,21 +153,13 @@ pub fn prepare_except(
     };
 
     // Representatives of exactly equal points.
-    let mut rep = Vec::with_capacity(n);
-    let mut duplicates = Vec::new();
-    {
-        let mut first: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-        first.reserve(n);
-        for (i, p) in pts.iter().enumerate() {
-            // Adding 0.0 turns -0.0 into 0.0, which compares equal to it.
-            let key = p.map(|v| (v + 0.0).to_bits());
-            let r = *first.entry(key).or_insert(i as u32);
-            rep.push(r);
-            if r != i as u32 {
-                duplicates.push((i as u32, r));
-            }
-        }
-    }
+    let rep = representatives(pts);
+    let duplicates: Vec<(u32, u32)> = rep
+        .iter()
+        .enumerate()
+        .filter(|&(i, &r)| r != i as u32)
+        .map(|(i, &r)| (i as u32, r))
+        .collect();
 
     // Cleaned polygons, in input order.
     let mut polys: Vec<Poly> = Vec::new();

@@ -16,13 +16,10 @@ pub mod tritri;
 
 use crate::error::InputError;
 use crate::geom::bvh::{Aabb, Bvh};
-use crate::plc::Plc;
+use crate::geom::polygon::{clean_ring, representatives};
+use crate::plc::{more, Plc, SHOWN};
 use rustc_hash::FxHashMap;
-use surface::clean_ring;
 pub use tritri::Contact;
-
-/// How many offending elements a message lists before "and N more".
-const SHOWN: usize = 5;
 
 /// One pair of intersecting facets, at one pair of their triangles.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,29 +77,6 @@ pub struct StrayVertex {
     pub tri: [u32; 3],
 }
 
-/// For each point, the lowest-indexed point with exactly equal coordinates.
-pub fn representatives(points: &[[f64; 3]]) -> Vec<u32> {
-    let mut first: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-    points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            // Adding 0.0 turns -0.0 into 0.0, which compares equal to it.
-            *first
-                .entry(p.map(|v| (v + 0.0).to_bits()))
-                .or_insert(i as u32)
-        })
-        .collect()
-}
-
-/// A facet's name in messages: its number as in the file, and its line when known.
-pub fn facet_name(plc: &Plc, fi: usize) -> String {
-    match plc.facets.get(fi).map(|f| f.line).unwrap_or(0) {
-        0 => format!("facet {}", fi + plc.first_index),
-        line => format!("facet {} (line {line})", fi + plc.first_index),
-    }
-}
-
 /// A point's number as in the file, with its coordinates.
 fn point_name(plc: &Plc, v: u32) -> String {
     let p = plc.points[v as usize];
@@ -124,15 +98,6 @@ fn tri_name(plc: &Plc, t: [u32; 3]) -> String {
         t[1] as usize + b,
         t[2] as usize + b
     )
-}
-
-/// "; and N more" when a list was cut.
-fn more(total: usize) -> String {
-    if total > SHOWN {
-        format!("; and {} more", total - SHOWN)
-    } else {
-        String::new()
-    }
 }
 
 /// The largest coordinate magnitude accepted: the exact predicates multiply up to five
@@ -247,7 +212,7 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
     }
     for (fi, f) in plc.facets.iter().enumerate() {
         for (pi, poly) in f.polygons.iter().enumerate() {
-            let at = || format!("{}, polygon {}", facet_name(plc, fi), pi + 1);
+            let at = || format!("{}, polygon {}", plc.facet_name(fi), pi + 1);
             if let Some(&v) = poly.iter().find(|&&v| v as usize >= n) {
                 return Err(invalid(
                     plc,
@@ -285,7 +250,7 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
                     plc,
                     format!(
                         "{}, polygon {}: its {} vertices are collinear: {}",
-                        facet_name(plc, fi),
+                        plc.facet_name(fi),
                         pi + 1,
                         ring.len(),
                         ring.iter()
@@ -310,7 +275,7 @@ pub fn check_elements(plc: &Plc) -> Result<Vec<u32>, InputError> {
                     format!(
                         "{}, polygon {} is not flat: vertex {} is {dev:.3e} off the polygon's \
                          plane, {:.2}% of its size {size:.3e} (at most {}% is accepted)",
-                        facet_name(plc, fi),
+                        plc.facet_name(fi),
                         pi + 1,
                         point_name(plc, v),
                         100.0 * dev / size,
@@ -387,42 +352,6 @@ fn hole_rings(plc: &Plc, rep: &[u32]) -> rustc_hash::FxHashSet<(usize, usize)> {
     out
 }
 
-/// Drops the polygons of a surface mesh that have fewer than three distinct corners once
-/// exactly equal points are welded (two corners at one point): they add nothing to the
-/// surface. One warning counts them and names the first few. Polygons with an index out
-/// of range are left for [`check_elements`] to report.
-pub fn drop_degenerate_polygons(plc: &mut Plc) {
-    let rep = representatives(&plc.points);
-    let n = plc.points.len();
-    let mut dropped: Vec<usize> = Vec::new();
-    for (fi, f) in plc.facets.iter_mut().enumerate() {
-        let before = f.polygons.len();
-        f.polygons.retain(|poly| {
-            poly.len() < 3
-                || poly.iter().any(|&v| v as usize >= n)
-                || clean_ring(poly, &rep).len() >= 3
-        });
-        if f.polygons.len() < before {
-            dropped.push(fi);
-        }
-    }
-    if dropped.is_empty() {
-        return;
-    }
-    let list: Vec<String> = dropped
-        .iter()
-        .take(SHOWN)
-        .map(|&fi| facet_name(plc, fi))
-        .collect();
-    plc.warnings.push(format!(
-        "{} facet(s) with a repeated corner (two corners at the same point) add nothing to \
-         the surface and were dropped: {}{}",
-        dropped.len(),
-        list.join(", "),
-        more(dropped.len())
-    ));
-}
-
 /// Duplicate polygons: the same set of (representative) vertices, both covering area (a
 /// polygon that bounds a hole of its own facet and is also a facet is a filled window).
 pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
@@ -470,9 +399,9 @@ pub fn check_duplicates(plc: &Plc, rep: &[u32]) -> Result<(), InputError> {
             .map(|&((fa, pa), (fb, pb))| {
                 format!(
                     "{}, polygon {} and {}, polygon {}",
-                    facet_name(plc, fa),
+                    plc.facet_name(fa),
                     pa + 1,
-                    facet_name(plc, fb),
+                    plc.facet_name(fb),
                     pb + 1
                 )
             })
@@ -519,7 +448,7 @@ pub fn intersections(plc: &Plc, rep: &[u32], warnings: &mut Vec<String>) -> Find
             .skipped
             .iter()
             .take(SHOWN)
-            .map(|(fi, why)| format!("{} ({why})", facet_name(plc, *fi)))
+            .map(|(fi, why)| format!("{} ({why})", plc.facet_name(*fi)))
             .collect();
         warnings.push(format!(
             "{} facet(s) could not be triangulated and were left out of the intersection check: {}{}",
@@ -621,8 +550,8 @@ pub fn segment_line(plc: &Plc, h: &SegmentHit) -> String {
         "segment ({}, {}) of {} and {} ({}) at triangle {}",
         h.seg[0] as usize + b,
         h.seg[1] as usize + b,
-        facet_name(plc, h.seg_facet),
-        facet_name(plc, h.facet),
+        plc.facet_name(h.seg_facet),
+        plc.facet_name(h.facet),
         h.kind.name(),
         tri_name(plc, h.tri)
     )
@@ -707,7 +636,7 @@ pub fn stray_line(plc: &Plc, s: &StrayVertex) -> String {
     format!(
         "point {} lies on {} (triangle {})",
         point_name(plc, s.point),
-        facet_name(plc, s.facet),
+        plc.facet_name(s.facet),
         tri_name(plc, s.tri)
     )
 }
@@ -716,8 +645,8 @@ pub fn stray_line(plc: &Plc, s: &StrayVertex) -> String {
 pub fn intersection_line(plc: &Plc, x: &Intersection) -> String {
     format!(
         "{} and {} ({}) at triangles {} and {}",
-        facet_name(plc, x.facets[0]),
-        facet_name(plc, x.facets[1]),
+        plc.facet_name(x.facets[0]),
+        plc.facet_name(x.facets[1]),
         x.kind.name(),
         tri_name(plc, x.tris[0]),
         tri_name(plc, x.tris[1])
@@ -832,7 +761,7 @@ fn edge_list(plc: &Plc, open: &[((u32, u32), usize)], with_facet: bool) -> Strin
         .map(|&((a, b), fi)| {
             let e = format!("{} – {}", point_name(plc, a), point_name(plc, b));
             if with_facet {
-                format!("{e} of {}", facet_name(plc, fi))
+                format!("{e} of {}", plc.facet_name(fi))
             } else {
                 e
             }

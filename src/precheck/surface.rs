@@ -2,8 +2,8 @@
 //! triangulated on its own (no merging), by the same 2D CDT the mesher uses, so a
 //! facet's triangles cover exactly its polygons minus its holes.
 
-use crate::constrained::facet2d::triangulate_facet;
-use crate::geom::polygon::newell_normal;
+use crate::geom::facet2d::triangulate_facet;
+use crate::geom::polygon::{clean_ring, newell_normal};
 use crate::plc::Plc;
 
 /// One triangle of an input facet, with representative vertex ids.
@@ -24,21 +24,6 @@ pub struct Surface {
     pub segments: Vec<([u32; 2], u32)>,
     /// Facets left out of the check: (0-based facet, why).
     pub skipped: Vec<(usize, String)>,
-}
-
-/// Drops repeated consecutive vertices, also across the wrap.
-pub(crate) fn clean_ring(poly: &[u32], rep: &[u32]) -> Vec<u32> {
-    let mut out: Vec<u32> = Vec::with_capacity(poly.len());
-    for &v in poly {
-        let r = rep[v as usize];
-        if out.last() != Some(&r) {
-            out.push(r);
-        }
-    }
-    while out.len() > 1 && out[0] == out[out.len() - 1] {
-        out.pop();
-    }
-    out
 }
 
 /// Triangulates every facet of `plc` (indices already checked against the points).
