@@ -234,7 +234,7 @@ pub(super) fn find(
         diag,
         facets: (0..prep.facets.len()).map(|_| None).collect(),
     };
-    let (on, simple) = nodes_on_facets(&mut geo, &chains, n_inputs);
+    let (on, simple, in_slabs) = nodes_on_facets(&mut geo, &chains, n_inputs);
     let mut subfaces = FxHashMap::default();
     subfaces.reserve(faces.len() / 4);
     let mut has_faces = vec![false; prep.facets.len()];
@@ -278,7 +278,7 @@ pub(super) fn find(
             bare.push((g as u32, q));
         }
     }
-    shims(&on, points, tets, prep, pr);
+    shims(&in_slabs, points, tets, prep, pr);
     Constraints {
         chains,
         subfaces,
@@ -303,7 +303,9 @@ impl<'a> Geometry<'a> {
     }
 }
 
-/// Tets with all four nodes on one facet that are flat are shims.
+/// Tets with all four nodes on one facet that are flat are shims; for this, as the
+/// shared referee counts them, a Steiner point lies on every facet whose slab holds it
+/// (`on`, from [`nodes_on_facets`]).
 fn shims(on: &Rows, points: &[Point], tets: &[[u32; 4]], prep: &PreparedPlc, pr: &mut Problems) {
     let mut common: Vec<u32> = Vec::new();
     for (t, tv) in tets.iter().enumerate() {
@@ -446,7 +448,14 @@ fn ring_is_ccw(ring: &[u32], proj: &Projection, points: &[Point]) -> bool {
 /// may fall just off a facet's boundary in projection), and other Steiner points on the
 /// facet whose slab and region hold them and whose plane is nearest. The lists leave out
 /// simple facets, which need none.
-fn nodes_on_facets(geo: &mut Geometry, chains: &[Vec<u32>], n_inputs: usize) -> (Rows, Vec<bool>) {
+///
+/// Also, for the shim test, the facets each node lies on when a Steiner point lies on
+/// every facet whose slab and box hold it (the rows then list simple facets too).
+fn nodes_on_facets(
+    geo: &mut Geometry,
+    chains: &[Vec<u32>],
+    n_inputs: usize,
+) -> (Rows, Vec<bool>, Rows) {
     let (prep, node, points) = (geo.prep, geo.node, geo.points);
     let mut placed = vec![false; points.len()];
     for &v in node.iter().take(n_inputs) {
@@ -494,20 +503,34 @@ fn nodes_on_facets(geo: &mut Geometry, chains: &[Vec<u32>], n_inputs: usize) -> 
         .filter(|&v| !placed[v as usize])
         .collect();
     let mut in_slab: Vec<(u32, u32)> = Vec::new();
-    if !loose.is_empty() {
+    // Every Steiner point with every facet whose slab and box hold it.
+    let mut in_slabs: Vec<(u32, u32)> = Vec::new();
+    let mut is_input = vec![false; points.len()];
+    for &v in node.iter().take(n_inputs) {
+        if v != u32::MAX {
+            is_input[v as usize] = true;
+        }
+    }
+    if (0..points.len()).any(|v| !is_input[v]) {
         let with_rings: Vec<usize> = (0..prep.facets.len())
             .filter(|&g| !prep.facets[g].rings.is_empty() && norm(&prep.facets[g].normal) > 0.0)
             .collect();
         let boxes: Vec<Aabb> = with_rings.iter().map(|&g| geo.facet(g).bbox).collect();
         let bvh = Bvh::build(&boxes);
-        for &v in &loose {
+        let mut near: Vec<usize> = Vec::new();
+        for v in (0..points.len() as u32).filter(|&v| !is_input[v as usize]) {
             let p = &points[v as usize];
-            let mut near: Vec<usize> = Vec::new();
+            near.clear();
             bvh.query(&boxes, &[*p, *p], |i| near.push(with_rings[i]));
+            let loose = !placed[v as usize];
             let mut best: Option<(f64, usize)> = None;
-            for g in near {
+            for &g in &near {
                 let f = geo.facet(g);
-                if f.in_slab(p) && f.locate(points, p) != RingSide::Outside {
+                if !f.in_slab(p) {
+                    continue;
+                }
+                in_slabs.push((v, g as u32));
+                if loose && f.locate(points, p) != RingSide::Outside {
                     let d = f.height(p).abs();
                     if best.is_none_or(|(b, _)| d < b) {
                         best = Some((d, g));
@@ -520,6 +543,7 @@ fn nodes_on_facets(geo: &mut Geometry, chains: &[Vec<u32>], n_inputs: usize) -> 
             }
         }
     }
+    debug_assert!(loose.iter().all(|&v| !is_input[v as usize]));
     let mut pairs = on_chain;
     pairs.extend(in_slab);
     for (g, f) in prep.facets.iter().enumerate() {
@@ -539,9 +563,30 @@ fn nodes_on_facets(geo: &mut Geometry, chains: &[Vec<u32>], n_inputs: usize) -> 
             }
         }
     }
+    // The facets that Steiner points lie in the slabs of, with their own vertices.
+    let mut with_slab_nodes: Vec<u32> = in_slabs.iter().map(|&(_, g)| g).collect();
+    with_slab_nodes.sort_unstable();
+    with_slab_nodes.dedup();
+    let mut shim_pairs = in_slabs;
+    shim_pairs.extend(pairs.iter().copied());
+    for &g in &with_slab_nodes {
+        let f = &prep.facets[g as usize];
+        for &v in f.rings.iter().flatten().chain(&f.isolated) {
+            let x = node[v as usize];
+            if x != u32::MAX {
+                shim_pairs.push((x, g));
+            }
+        }
+    }
     pairs.sort_unstable();
     pairs.dedup();
-    (Rows::new(points.len(), pairs.into_iter()), simple)
+    shim_pairs.sort_unstable();
+    shim_pairs.dedup();
+    (
+        Rows::new(points.len(), pairs.into_iter()),
+        simple,
+        Rows::new(points.len(), shim_pairs.into_iter()),
+    )
 }
 
 /// Calls `f` with every edge of the facet's rings and its inner segments, as sorted

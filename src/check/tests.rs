@@ -358,3 +358,39 @@ fn a_second_layer_of_tets_is_found_by_the_tiling_count() {
         .to_string();
     assert!(e.contains("tets overlap"), "{e}");
 }
+
+#[test]
+fn a_shim_with_a_steiner_point_in_a_facets_slab_fails() {
+    // A tetrahedron whose bottom facet is the triangle (0, 1, 2); a Steiner point in the
+    // bottom's plane and box but outside the triangle lies on no facet by the nearest-
+    // plane rule, yet in the bottom's slab, as the shared referee counts it: the flat
+    // tet of the three bottom corners and that point is a shim.
+    let mut plc = Plc::from_points(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.2, 0.2, 1.0],
+        ],
+        0,
+    );
+    plc.facets = [[0, 1, 2], [0, 1, 3], [1, 2, 3], [2, 0, 3]]
+        .into_iter()
+        .map(|p| Facet {
+            polygons: vec![p.to_vec()],
+            ..Default::default()
+        })
+        .collect();
+    let mut m = meshed(&plc, true);
+    check(&plc, &m).unwrap();
+    m.points.push([0.7, 0.7, 0.0]);
+    m.tets.insert(0, oriented(&m.points, [0, 1, 2, 4]));
+    m.neighbors.clear();
+    let e = check(&plc, &m).unwrap_err();
+    assert!(
+        e.listed
+            .iter()
+            .any(|l| l.starts_with("tet 0 ") && l.contains("is a shim")),
+        "{e:?}"
+    );
+}
