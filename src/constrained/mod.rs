@@ -229,16 +229,6 @@ fn still_conflicting(points: usize) -> Error {
     .into()
 }
 
-/// The state to start the constructions over from, with updates in place turned off
-/// (`stats0` as at the start): no points from earlier attempts, no work done.
-fn without_updates(stats0: &PlcStats) -> (Vec<FacetPoint>, Vec<SegmentSplit>, u64, PlcStats) {
-    let stats = PlcStats {
-        in_place_off: true,
-        ..stats0.clone()
-    };
-    (Vec::new(), Vec::new(), 0, stats)
-}
-
 /// A finished CDT of a PLC before carving: what [`crate::pipeline::mesh_plc`] carves, and what
 /// [`crate::live::Cdt`] keeps to insert into.
 pub(crate) struct Constructed {
@@ -264,223 +254,42 @@ pub(crate) fn construct(
     progress(Stage::Delaunay);
     let ((base, all_merged), first_dt) = prepare_beside_delaunay(plc, opts)?;
     let merged = all_merged.as_ref().unwrap_or(&base);
-    // `base` with the groups that could not be triangulated in one plane kept apart.
-    let mut split: Option<PreparedPlc> = None;
-    let prep = &base;
-    let mut first_dt = Some(first_dt);
-    // Input facets kept out of merging because their merged group could not be
-    // triangulated in one plane.
-    let mut keep_apart: Vec<usize> = Vec::new();
-    let mut warnings: Vec<String> = prep
-        .duplicates
-        .iter()
-        .map(|&(dup, kept)| {
-            let p = plc.points[kept as usize];
-            format!(
-                "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
-                dup as usize + plc.first_index,
-                kept as usize + plc.first_index,
-                p[0],
-                p[1],
-                p[2]
-            )
-        })
-        .collect();
-    let mut stats = PlcStats {
+    let mut warnings = duplicate_warnings(plc, &base);
+    let stats = PlcStats {
         inserter: opts.inserter,
         input_points: plc.points.len(),
         input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
-        duplicate_points: prep.duplicates.len(),
+        duplicate_points: base.duplicates.len(),
         ..Default::default()
     };
-    // Steiner points on polygons, found by earlier attempts: (merged facet, point); and
-    // split points on segments: (segment, parameter).
-    let mut facet_points: Vec<(usize, Point)> = Vec::new();
-    let mut presplits: Vec<(usize, f64)> = Vec::new();
-    let mut first_work = 0u64;
-    // A construction that leaves a few thick tets on facets is followed by others, each
-    // started with one point off such a tet's facet; the first that leaves none is
-    // taken, else the first construction.
-    let stats0 = stats.clone();
-    let mut retry: Option<Retry> = None;
-    // Set when a retry's construction fails or does no better: the next point is tried,
-    // or, when none is left, the first construction is taken.
-    let mut retry_failed = false;
-    // The complete construction with the fewest tets on facets among those that asked for
-    // another only to improve on it: taken if the restarts end no better, or, if it left
-    // none, over their bounds (they only improve a valid CDT).
-    let mut best: Option<Kept> = None;
+    let mut run = Constructions {
+        plc,
+        opts,
+        base: &base,
+        merged,
+        split: None,
+        keep_apart: Vec::new(),
+        first_dt: Some(first_dt),
+        stats0: stats.clone(),
+        stats,
+        facet_points: Vec::new(),
+        presplits: Vec::new(),
+        first_work: 0,
+        retry: None,
+        retry_failed: false,
+        best: None,
+    };
     let built = loop {
-        if std::mem::take(&mut retry_failed) {
-            if let Some(state) = retry.as_mut().and_then(|r| r.next(&stats0)) {
-                (facet_points, presplits, stats, first_work) = state;
-            } else if let Some(r) = retry.take() {
-                let (b, st, fp) = r.fallback;
-                (stats, facet_points) = (st, fp);
-                break b;
-            }
-        }
-        opts.check_cancel()?;
-        let prep = split.as_ref().unwrap_or(&base);
-        // A construction after the first stops where the restarts' bound would end it
-        // anyway: one region around a far vertex can cost minutes.
-        let work_limit = if stats.restarts == 0 {
-            u64::MAX
-        } else {
-            restart_work_bound(first_work).saturating_sub(stats.work)
-        };
-        let result = match attempt(
-            plc,
-            first_dt.take(),
-            [prep, merged],
-            (&facet_points, &presplits),
-            opts,
-            (&mut stats, work_limit),
-            progress,
-        ) {
-            Err(Error::Mesh(MeshError::UnflatGroup {
-                sources,
-                facet,
-                reason,
-            })) if retry.is_none() => {
-                // The group is split and meshed again, unless it already was.
-                if sources.is_empty() || sources.iter().all(|s| keep_apart.contains(s)) {
-                    return Err(MeshError::Failed(format!("facet {facet}: {reason}")).into());
-                }
-                best = None;
-                keep_apart.extend(sources);
-                keep_apart.sort_unstable();
-                keep_apart.dedup();
-                split = Some(prepare::prepare_except(plc, opts.merge, &keep_apart)?);
-                facet_points.clear();
-                presplits.clear();
-                continue;
-            }
-            r => r,
-        };
-        // In a retry, a failed construction only moves on to the next point.
-        let outcome = match result {
-            Ok(o) => o,
-            Err(_) if retry.is_some() => {
-                retry_failed = true;
-                continue;
-            }
-            // Updates in place may lead a construction astray where restarts would
-            // not: it is done again without them.
-            Err(e) if stats.in_place_splits > 0 && !stats.in_place_off => {
-                if debug() {
-                    eprintln!("restart {} without updates in place: {e}", stats.restarts);
-                }
-                (facet_points, presplits, first_work, stats) = without_updates(&stats0);
-                continue;
-            }
-            Err(Error::Mesh(MeshError::WorkBound)) => match best.take() {
-                Some(b) if retry.is_none() && b.0.tets_on_facets() == 0 => {
-                    break take_best(b, &mut stats, &mut facet_points);
-                }
-                _ => return Err(still_conflicting(facet_points.len())),
-            },
-            Err(e) => return Err(e),
-        };
-        match outcome {
-            Attempt::Done(built) => match retry.as_mut() {
-                None if !built.retry_points.is_empty() => {
-                    if debug() {
-                        eprintln!("{} tets left on facets: retries", built.flat_left.tets);
-                    }
-                    let points = built.retry_points.clone();
-                    let r = retry.insert(Retry {
-                        fallback: (built, stats.clone(), facet_points.clone()),
-                        points,
-                        next: 0,
-                    });
-                    (facet_points, presplits, stats, first_work) = r.start(&stats0);
-                    continue;
-                }
-                None => match best.take() {
-                    Some(b) if b.0.tets_on_facets() < built.tets_on_facets() => {
-                        if debug() {
-                            eprintln!(
-                                "{} tets on facets left: an earlier construction's {} taken",
-                                built.tets_on_facets(),
-                                b.0.tets_on_facets()
-                            );
-                        }
-                        break take_best(b, &mut stats, &mut facet_points);
-                    }
-                    _ => break built,
-                },
-                Some(r) => {
-                    if debug() {
-                        eprintln!(
-                            "retry with {:?}: {} left, covering {}",
-                            r.points[r.next], built.flat_left.tets, built.first_point_covers
-                        );
-                    }
-                    if built.flat_left.tets == 0 && !built.first_point_covers {
-                        break built;
-                    }
-                    retry_failed = true;
-                    continue;
-                }
-            },
-            Attempt::Restart(more, splits, fallback) => {
-                stats.restarts += 1;
-                if let Some(b) = fallback {
-                    if best
-                        .as_ref()
-                        .is_none_or(|x| b.tets_on_facets() < x.0.tets_on_facets())
-                    {
-                        best = Some((b, stats.clone(), facet_points.clone()));
-                    }
-                }
-                if stats.restarts == 1 {
-                    first_work = stats.work;
-                }
-                if debug() {
-                    eprintln!(
-                        "restart {} work {} first {}",
-                        stats.restarts, stats.work, first_work
-                    );
-                }
-                let over_steiner = facet_points.len() + more.len() > opts.max_steiner;
-                // Restarts may cost far more than the first attempt when the polygons'
-                // vertices are wildly off their planes: bound that work too.
-                let over_work = stats.restarts > MAX_RESTARTS
-                    || facet_points.len() + more.len() + presplits.len() + splits.len()
-                        > max_facet_points(plc)
-                    || stats.work > restart_work_bound(first_work);
-                // Past the bounds, an earlier construction is taken only if it left no tets
-                // on facets; one that did is no mesh to succeed with.
-                let clean = best.as_ref().is_some_and(|b| b.0.tets_on_facets() == 0);
-                if (over_steiner || over_work) && retry.is_none() && clean {
-                    if let Some(b) = best.take() {
-                        break take_best(b, &mut stats, &mut facet_points);
-                    }
-                }
-                if (over_steiner || over_work) && retry.is_some() {
-                    retry_failed = true;
-                    continue;
-                }
-                if (over_steiner || over_work) && stats.in_place_splits > 0 && !stats.in_place_off {
-                    (facet_points, presplits, first_work, stats) = without_updates(&stats0);
-                    continue;
-                }
-                if over_steiner {
-                    return Err(MeshError::Failed(format!(
-                        "polygons that are not flat need more than {} Steiner points (the -S limit)",
-                        opts.max_steiner
-                    ))
-                    .into());
-                }
-                if over_work {
-                    return Err(still_conflicting(facet_points.len()));
-                }
-                facet_points.extend(more);
-                presplits.extend(splits);
-            }
+        if let Next::Done(built) = run.step(progress)? {
+            break built;
         }
     };
+    let Constructions {
+        mut stats,
+        facet_points,
+        split,
+        ..
+    } = run;
     let free = facet_points.iter().filter(|p| p.0 == FREE_POINT).count();
     stats.facet_steiner_points += facet_points.len() - free;
     stats.free_steiner_points += free;
@@ -498,6 +307,300 @@ pub(crate) fn construct(
         stats,
         warnings,
     })
+}
+
+/// A warning for each input point that coincides with an earlier one.
+fn duplicate_warnings(plc: &Plc, prep: &PreparedPlc) -> Vec<String> {
+    prep.duplicates
+        .iter()
+        .map(|&(dup, kept)| {
+            let p = plc.points[kept as usize];
+            format!(
+                "point {} coincides with point {} at ({}, {}, {}) and is merged with it",
+                dup as usize + plc.first_index,
+                kept as usize + plc.first_index,
+                p[0],
+                p[1],
+                p[2]
+            )
+        })
+        .collect()
+}
+
+/// The constructions of one PLC, one after another, and what carries over between them.
+struct Constructions<'a> {
+    plc: &'a Plc,
+    opts: &'a PlcOptions,
+    /// The PLC as prepared, and with every coplanar group merged.
+    base: &'a PreparedPlc,
+    merged: &'a PreparedPlc,
+    /// `base` with the groups that could not be triangulated in one plane kept apart
+    /// (their input facets in `keep_apart`).
+    split: Option<PreparedPlc>,
+    keep_apart: Vec<usize>,
+    /// The Delaunay tetrahedralization of the input points, made beside the preparation,
+    /// for the first construction.
+    first_dt: Option<(Delaunay, f64)>,
+    stats: PlcStats,
+    /// The figures as at the start.
+    stats0: PlcStats,
+    /// Steiner points on polygons found by earlier constructions: (merged facet, point);
+    /// and split points on segments: (segment, parameter).
+    facet_points: Vec<FacetPoint>,
+    presplits: Vec<SegmentSplit>,
+    /// The work of the first construction (bounds the restarts').
+    first_work: u64,
+    /// A construction that leaves a few thick tets on facets is followed by others, each
+    /// started with one point off such a tet's facet; the first that leaves none is
+    /// taken, else the first construction. `retry_failed` is set when a retry's
+    /// construction fails or does no better: the next point is tried.
+    retry: Option<Retry>,
+    retry_failed: bool,
+    /// The complete construction with the fewest tets on facets among those that asked
+    /// for another only to improve on it: taken if the restarts end no better, or, if it
+    /// left none, over their bounds (they only improve a valid CDT).
+    best: Option<Kept>,
+}
+
+/// What [`Constructions::step`] leads to.
+enum Next {
+    /// Another construction.
+    Again,
+    /// The CDT to carve.
+    Done(Box<Built>),
+}
+
+impl Constructions<'_> {
+    /// One construction, and what comes after it.
+    fn step(&mut self, progress: Progress<'_>) -> Result<Next, Error> {
+        if std::mem::take(&mut self.retry_failed) {
+            if let Some(state) = self.retry.as_mut().and_then(|r| r.next(&self.stats0)) {
+                (
+                    self.facet_points,
+                    self.presplits,
+                    self.stats,
+                    self.first_work,
+                ) = state;
+            } else if let Some(r) = self.retry.take() {
+                let (b, st, fp) = r.fallback;
+                (self.stats, self.facet_points) = (st, fp);
+                return Ok(Next::Done(b));
+            }
+        }
+        self.opts.check_cancel()?;
+        let prep = self.split.as_ref().unwrap_or(self.base);
+        // A construction after the first stops where the restarts' bound would end it
+        // anyway: one region around a far vertex can cost minutes.
+        let work_limit = if self.stats.restarts == 0 {
+            u64::MAX
+        } else {
+            restart_work_bound(self.first_work).saturating_sub(self.stats.work)
+        };
+        let result = attempt(
+            self.plc,
+            self.first_dt.take(),
+            [prep, self.merged],
+            (&self.facet_points, &self.presplits),
+            self.opts,
+            (&mut self.stats, work_limit),
+            progress,
+        );
+        let outcome = match result {
+            Ok(o) => o,
+            Err(e) => return self.after_failure(e),
+        };
+        match outcome {
+            Attempt::Done(built) => Ok(self.after_done(built)),
+            Attempt::Restart(more, splits, fallback) => self.after_restart(more, splits, fallback),
+        }
+    }
+
+    /// After a construction that failed with `e`.
+    fn after_failure(&mut self, e: Error) -> Result<Next, Error> {
+        match e {
+            Error::Mesh(MeshError::UnflatGroup {
+                sources,
+                facet,
+                reason,
+            }) if self.retry.is_none() => {
+                // The group is split and meshed again, unless it already was.
+                if sources.is_empty() || sources.iter().all(|s| self.keep_apart.contains(s)) {
+                    return Err(MeshError::Failed(format!("facet {facet}: {reason}")).into());
+                }
+                self.best = None;
+                self.keep_apart.extend(sources);
+                self.keep_apart.sort_unstable();
+                self.keep_apart.dedup();
+                self.split = Some(prepare::prepare_except(
+                    self.plc,
+                    self.opts.merge,
+                    &self.keep_apart,
+                )?);
+                self.facet_points.clear();
+                self.presplits.clear();
+                Ok(Next::Again)
+            }
+            // In a retry, a failed construction only moves on to the next point.
+            _ if self.retry.is_some() => {
+                self.retry_failed = true;
+                Ok(Next::Again)
+            }
+            // Updates in place may lead a construction astray where restarts would
+            // not: it is done again without them.
+            e if self.stats.in_place_splits > 0 && !self.stats.in_place_off => {
+                if debug() {
+                    eprintln!(
+                        "restart {} without updates in place: {e}",
+                        self.stats.restarts
+                    );
+                }
+                self.start_without_updates();
+                Ok(Next::Again)
+            }
+            Error::Mesh(MeshError::WorkBound) => match self.best.take() {
+                Some(b) if b.0.tets_on_facets() == 0 => Ok(Next::Done(self.take_best(b))),
+                _ => Err(still_conflicting(self.facet_points.len())),
+            },
+            e => Err(e),
+        }
+    }
+
+    /// After a construction that ended with a CDT.
+    fn after_done(&mut self, built: Box<Built>) -> Next {
+        let Some(r) = self.retry.as_mut() else {
+            if !built.retry_points.is_empty() {
+                if debug() {
+                    eprintln!("{} tets left on facets: retries", built.flat_left.tets);
+                }
+                let points = built.retry_points.clone();
+                let r = self.retry.insert(Retry {
+                    fallback: (built, self.stats.clone(), self.facet_points.clone()),
+                    points,
+                    next: 0,
+                });
+                (
+                    self.facet_points,
+                    self.presplits,
+                    self.stats,
+                    self.first_work,
+                ) = r.start(&self.stats0);
+                return Next::Again;
+            }
+            return match self.best.take() {
+                Some(b) if b.0.tets_on_facets() < built.tets_on_facets() => {
+                    if debug() {
+                        eprintln!(
+                            "{} tets on facets left: an earlier construction's {} taken",
+                            built.tets_on_facets(),
+                            b.0.tets_on_facets()
+                        );
+                    }
+                    Next::Done(self.take_best(b))
+                }
+                _ => Next::Done(built),
+            };
+        };
+        if debug() {
+            eprintln!(
+                "retry with {:?}: {} left, covering {}",
+                r.points[r.next], built.flat_left.tets, built.first_point_covers
+            );
+        }
+        if built.flat_left.tets == 0 && !built.first_point_covers {
+            return Next::Done(built);
+        }
+        self.retry_failed = true;
+        Next::Again
+    }
+
+    /// After a construction that asked for another with Steiner points `more` and
+    /// segment splits `splits` (with its own CDT, `fallback`, when they only improve it).
+    fn after_restart(
+        &mut self,
+        more: Vec<FacetPoint>,
+        splits: Vec<SegmentSplit>,
+        fallback: Option<Box<Built>>,
+    ) -> Result<Next, Error> {
+        self.stats.restarts += 1;
+        if let Some(b) = fallback {
+            if self
+                .best
+                .as_ref()
+                .is_none_or(|x| b.tets_on_facets() < x.0.tets_on_facets())
+            {
+                self.best = Some((b, self.stats.clone(), self.facet_points.clone()));
+            }
+        }
+        if self.stats.restarts == 1 {
+            self.first_work = self.stats.work;
+        }
+        if debug() {
+            eprintln!(
+                "restart {} work {} first {}",
+                self.stats.restarts, self.stats.work, self.first_work
+            );
+        }
+        let points = self.facet_points.len() + more.len();
+        let over_steiner = points > self.opts.max_steiner;
+        // Restarts may cost far more than the first attempt when the polygons' vertices
+        // are wildly off their planes: bound that work too.
+        let over_work = self.stats.restarts > MAX_RESTARTS
+            || points + self.presplits.len() + splits.len() > max_facet_points(self.plc)
+            || self.stats.work > restart_work_bound(self.first_work);
+        if over_steiner || over_work {
+            // Past the bounds, an earlier construction is taken only if it left no tets on
+            // facets; one that did is no mesh to succeed with.
+            let clean = self
+                .best
+                .as_ref()
+                .is_some_and(|b| b.0.tets_on_facets() == 0);
+            if self.retry.is_none() && clean {
+                if let Some(b) = self.best.take() {
+                    return Ok(Next::Done(self.take_best(b)));
+                }
+            }
+            if self.retry.is_some() {
+                self.retry_failed = true;
+                return Ok(Next::Again);
+            }
+            if self.stats.in_place_splits > 0 && !self.stats.in_place_off {
+                self.start_without_updates();
+                return Ok(Next::Again);
+            }
+            if over_steiner {
+                return Err(MeshError::Failed(format!(
+                    "polygons that are not flat need more than {} Steiner points (the -S limit)",
+                    self.opts.max_steiner
+                ))
+                .into());
+            }
+            return Err(still_conflicting(self.facet_points.len()));
+        }
+        self.facet_points.extend(more);
+        self.presplits.extend(splits);
+        Ok(Next::Again)
+    }
+
+    /// Starts the constructions over with updates in place turned off: no points from
+    /// earlier attempts, no work done.
+    fn start_without_updates(&mut self) {
+        self.stats = PlcStats {
+            in_place_off: true,
+            ..self.stats0.clone()
+        };
+        self.facet_points.clear();
+        self.presplits.clear();
+        self.first_work = 0;
+    }
+
+    /// Takes kept construction `kept` as the outcome: its figures and points replace the
+    /// current ones, but the restarts made since are still counted.
+    fn take_best(&mut self, (built, mut kept_stats, kept_points): Kept) -> Box<Built> {
+        kept_stats.restarts = self.stats.restarts;
+        self.stats = kept_stats;
+        self.facet_points = kept_points;
+        built
+    }
 }
 
 /// The PLC as meshed, and (without merging) as prepared with every group merged.
@@ -595,19 +698,6 @@ struct Retry {
 /// A complete construction kept in case later ones do no better: its CDT, its figures
 /// and the points it started from.
 type Kept = (Box<Built>, PlcStats, Vec<FacetPoint>);
-
-/// Takes kept construction `kept` as the outcome: its figures and points replace the
-/// current ones, but the restarts made since are still counted.
-fn take_best(
-    (built, mut kept_stats, kept_points): Kept,
-    stats: &mut PlcStats,
-    facet_points: &mut Vec<FacetPoint>,
-) -> Box<Built> {
-    kept_stats.restarts = stats.restarts;
-    *stats = kept_stats;
-    *facet_points = kept_points;
-    built
-}
 
 /// What a construction starts from: its points, splits, figures and first work.
 type StartState = (Vec<FacetPoint>, Vec<SegmentSplit>, PlcStats, u64);
