@@ -1061,3 +1061,29 @@ fn a_thin_wedge_keeps_its_folded_faces_apart_as_tetgen_does() {
         );
     }
 }
+
+/// CSG parts rounded to 6 digits (`data/csg/`, from `scripts/gen-csg-parts.py`): both
+/// insertion algorithms give certified meshes (`--check`) that the referee accepts.
+#[test]
+fn csg_parts_rounded_to_six_digits_mesh_validly() {
+    let csg = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/csg");
+    let jobs: Vec<(PathBuf, &str)> = ["bricks_9.off", "flange_7.off", "cheese_4.off"]
+        .iter()
+        .flat_map(|p| [(csg.join(p), "-pQ"), (csg.join(p), "-pQF")])
+        .collect();
+    let script = validator();
+    let dir = tempfile::tempdir().unwrap();
+    let failures = for_each_parallel(&jobs, |(m, sw)| {
+        let name = file_name(m);
+        let prefix = dir.path().join(format!("{name}{sw}"));
+        let (code, err) = run(m, &prefix, &[sw, "--check"]);
+        if code != 0 {
+            return Some(format!("{name} {sw}: exit {code}: {err}"));
+        }
+        let script = script.as_ref()?;
+        referee(script, m, &prefix, &[])
+            .err()
+            .map(|e| format!("{name} {sw}: the referee rejects the mesh: {e}"))
+    });
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
