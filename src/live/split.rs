@@ -476,6 +476,8 @@ impl Cdt {
                 _ => Err(InsertError::Refused(m)),
             };
         };
+        // The subsegments change (and may change back if the split is undone).
+        self.ends = None;
         let marker = split_edge.and_then(|e| self.tets.subsegs.remove(&e));
         if let (Some(k), Some((a, b))) = (marker, edge) {
             self.tets.subsegs.insert(edge_key(a, vertex), k);
