@@ -18,7 +18,7 @@ use super::{
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
 use crate::geom::Point;
-use crate::mesh::{VertexId, VertexLists};
+use crate::mesh::VertexId;
 use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
@@ -196,8 +196,6 @@ struct Construction<'a> {
     in_place_for: FxHashMap<[u64; 3], usize>,
     /// The splits and points they made, for the next construction if there is one.
     carried: (Vec<SegmentSplit>, Vec<FacetPoint>),
-    /// The subsegments' ends, which points put in check, while they stand.
-    ends: Option<VertexLists<VertexId>>,
     /// Facets to triangulate again once the current one is done (after a subsegment was
     /// split in place), and the facets of each segment, made when first needed.
     retriangulate: Vec<usize>,
@@ -355,7 +353,6 @@ impl<'a> Construction<'a> {
             in_place: 0,
             in_place_for: FxHashMap::default(),
             carried: (Vec::new(), Vec::new()),
-            ends: None,
             retriangulate: Vec::new(),
             facets_of_seg: None,
             search: None,
@@ -487,10 +484,7 @@ impl<'a> Construction<'a> {
             && self.stats.work + self.cdt.work.get() < RESTART_WORK / 4;
         *asked += 1;
         if room {
-            let at = self
-                .ends
-                .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
-            let inserted = free::insert_point(&mut self.cdt, p, self.next_pert, at, false)?;
+            let inserted = free::insert_point(&mut self.cdt, p, self.next_pert, false)?;
             // Refused, and for which subsegment if one would be lost.
             let refused = match &inserted {
                 free::Inserted::Refused { lost, .. } => Some(*lost),
@@ -529,16 +523,13 @@ impl<'a> Construction<'a> {
             // it in: without them (and those it wraps around) it may go in, and the
             // facets are triangulated with it and recovered again.
             let mut segs = segs!(self);
-            let at = self
-                .ends
-                .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
             let cdt = &mut self.cdt;
             let pert = self.next_pert;
             let (mut split, mut unrecovered) = (None, None);
             if let (Some(lost), true) = (refused, update) {
                 split = split_encroached(cdt, p, lost, &mut segs, pert, 0)?;
                 if split.is_none() {
-                    match insert_unrecovered(cdt, p, fi, pert, at)? {
+                    match insert_unrecovered(cdt, p, fi, pert)? {
                         Ok(done) => unrecovered = Some(done),
                         // Then the subsegment it would remove is split.
                         Err(Some(lost)) => {
@@ -575,7 +566,6 @@ impl<'a> Construction<'a> {
                 }
             };
             if let Some(facets) = facets {
-                self.ends = None;
                 self.next_pert += points;
                 self.stats.steiner_points += points as usize;
                 count_update(&mut self.cdt, &mut self.in_place, self.stats);
@@ -762,10 +752,7 @@ impl<'a> Construction<'a> {
     /// splits the subsegments they would remove. Whether either was done: the facets
     /// are then queued to be recovered again.
     fn free_in_place_update(&mut self, refused: &[Point]) -> Result<bool, Error> {
-        let at = self
-            .ends
-            .get_or_insert_with(|| free::subsegment_ends(&self.cdt));
-        match insert_free_unrecovering(&mut self.cdt, refused, self.next_pert, at)? {
+        match insert_free_unrecovering(&mut self.cdt, refused, self.next_pert)? {
             FreeInPlace::In(vertices, facets) => {
                 if debug() {
                     eprintln!("free points {refused:?}: in with facets {facets:?} unrecovered");
@@ -809,7 +796,6 @@ impl<'a> Construction<'a> {
                 if again.is_empty() {
                     return Ok(false);
                 }
-                self.ends = None;
                 self.triangulate_again(again);
                 Ok(true)
             }

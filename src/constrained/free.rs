@@ -10,16 +10,10 @@ use super::slivers::Candidate;
 use crate::delaunay::{Change, Walled};
 use crate::error::MeshError;
 use crate::geom::{insphere_sos, Point, Sign};
-use crate::mesh::{FaceRef, TetId, VertexId, VertexLists, FACE_VERTS};
+use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS};
 
 /// Flips per inserted point beyond which the point is taken back.
 const MAX_FLIPS: usize = 20_000;
-
-/// The vertices joined to each vertex by a subsegment: what [`insert_point`] checks.
-pub(crate) fn subsegment_ends(cdt: &Cdt) -> VertexLists<VertexId> {
-    let ends = cdt.subsegs.keys().flat_map(|&(a, b)| [(a, b), (b, a)]);
-    VertexLists::new(cdt.dt.points.len(), ends)
-}
 
 /// Inserts free points into the CDT, one from each list of candidates (the first that
 /// fits, and that `accept` takes if it is to be checked), and returns how many it added
@@ -32,12 +26,11 @@ pub(super) fn insert_free(
     next_pert: &mut u32,
     mut accept: impl FnMut(&Cdt, VertexId) -> bool,
 ) -> Result<(usize, Vec<Point>), MeshError> {
-    let at = subsegment_ends(cdt);
     let mut added = 0;
     let mut refused = Vec::new();
     'tets: for ws in free {
         for c in ws {
-            let inserted = insert_point(cdt, c.at, *next_pert, &at, false)?;
+            let inserted = insert_point(cdt, c.at, *next_pert, false)?;
             match &inserted {
                 &Inserted::Yes { vertex, .. } if c.checked && !accept(cdt, vertex) => {
                     if super::debug() {
@@ -80,14 +73,13 @@ pub(crate) enum Inserted {
 
 /// Inserts point `w` (perturbation index `pert`) into the CDT: a cavity walled in by the
 /// subfaces, then flips until every face is locally Delaunay again. Refused, leaving
-/// the CDT as it was, if the flips cannot get there or a subsegment (`at`, from
-/// [`subsegment_ends`]) would be lost. `wrapped_asked`: whether a refusal should name the
+/// the CDT as it was, if the flips cannot get there or a subsegment would be lost.
+/// `wrapped_asked`: whether a refusal should name the
 /// subface in the way (a search, wasted where nobody asks).
 pub(crate) fn insert_point(
     cdt: &mut Cdt,
     w: Point,
     pert: u32,
-    at: &VertexLists<VertexId>,
     wrapped_asked: bool,
 ) -> Result<Inserted, MeshError> {
     let subfaces = &cdt.subfaces;
@@ -121,23 +113,22 @@ pub(crate) fn insert_point(
             });
         }
     };
-    settle(cdt, w, (vertex, first, last), at, wrapped_asked)
+    settle(cdt, w, (vertex, first, last), wrapped_asked)
 }
 
 /// After vertex `vertex` (at `w`) went in by change `first` (point location started at
 /// `last` before), flips the faces that are not locally Delaunay; the point is in if
-/// that settles and no subsegment (`at`) is lost, else it is taken back.
+/// that settles and no subsegment is lost, else it is taken back.
 pub(crate) fn settle(
     cdt: &mut Cdt,
     w: Point,
     (vertex, first, last): (VertexId, Change, TetId),
-    at: &VertexLists<VertexId>,
     wrapped_asked: bool,
 ) -> Result<Inserted, MeshError> {
     let mut changes = vec![first];
     let settled = flip_to_delaunay(cdt, &mut changes)?;
     let (lost, wrapped) = match settled {
-        Ok(()) => (lost_subsegment(cdt, &changes, at), None),
+        Ok(()) => (lost_subsegment(cdt, &changes), None),
         Err(in_way) => (None, in_way.filter(|_| wrapped_asked)),
     };
     let settled = settled.is_ok();
@@ -266,23 +257,16 @@ fn not_delaunay(cdt: &Cdt, f: FaceRef) -> bool {
     insphere_sos(p, orig) == Sign::Positive
 }
 
-/// A subsegment between vertices of the changed tets that is no longer a mesh edge
-/// (only those can have gone), if any.
-fn lost_subsegment(
-    cdt: &mut Cdt,
-    changes: &[Change],
-    at: &VertexLists<VertexId>,
-) -> Option<(VertexId, VertexId)> {
-    let mut verts: Vec<VertexId> = changes
+/// The first (in vertex order) subsegment that is an edge of a tet the changes removed
+/// and no longer a mesh edge (only those can have gone), if any.
+fn lost_subsegment(cdt: &mut Cdt, changes: &[Change]) -> Option<(VertexId, VertexId)> {
+    let mut edges: Vec<(VertexId, VertexId)> = changes
         .iter()
-        .flat_map(|c| c.old.iter().flat_map(|(_, tet)| tet.v))
+        .flat_map(|c| c.old.iter())
+        .flat_map(|(_, tet)| EDGE_VERTS.map(|(i, j)| edge_key(tet.v[i], tet.v[j])))
+        .filter(|e| cdt.subsegs.contains_key(e))
         .collect();
-    verts.sort_unstable();
-    verts.dedup();
-    verts.iter().find_map(|&x| {
-        at.of(x)
-            .iter()
-            .find(|&&y| x < y && verts.binary_search(&y).is_ok() && !cdt.has_edge(x, y))
-            .map(|&y| (x, y))
-    })
+    edges.sort_unstable();
+    edges.dedup();
+    edges.into_iter().find(|&(x, y)| !cdt.has_edge(x, y))
 }

@@ -16,19 +16,17 @@ use rustc_hash::FxHashMap;
 /// [`MAX_UNRECOVERED`] more facets whose subfaces are in its way (see
 /// [`insert_unrecovering`]). Its vertex and the facets taken out, to be triangulated and
 /// recovered again; or, with the subfaces put back, the subsegment it would remove, if
-/// that is why the CDT refuses it all the same. `at` as for [`free::insert_point`]
-/// (taking subfaces out leaves it).
+/// that is why the CDT refuses it all the same.
 pub(super) fn insert_unrecovered(
     cdt: &mut Cdt,
     p: Point,
     fi: usize,
     pert: u32,
-    at: &crate::mesh::VertexLists<VertexId>,
 ) -> Result<Unrecovered, MeshError> {
     let mut facets = vec![fi];
     let mut removed = take_out_subfaces(cdt, |f| f as usize == fi);
     let limit = 1 + MAX_UNRECOVERED;
-    let inserted = insert_unrecovering(cdt, (p, pert), at, (&mut facets, limit), &mut removed)?;
+    let inserted = insert_unrecovering(cdt, (p, pert), (&mut facets, limit), &mut removed)?;
     Ok(match inserted {
         free::Inserted::Yes { vertex, .. } => Ok((vertex, facets)),
         refused => {
@@ -61,7 +59,6 @@ pub(super) fn insert_free_unrecovering(
     cdt: &mut Cdt,
     ps: &[Point],
     pert: u32,
-    at: &crate::mesh::VertexLists<VertexId>,
 ) -> Result<FreeInPlace, MeshError> {
     let mut done: Vec<(free::Inserted, TakenOut)> = Vec::new();
     let mut facets = Vec::new();
@@ -71,7 +68,7 @@ pub(super) fn insert_free_unrecovering(
         let (mut through, mut removed) = (Vec::new(), Vec::new());
         let limit = MAX_UNRECOVERED;
         let pk = (p, pert + k as u32);
-        let inserted = insert_unrecovering(cdt, pk, at, (&mut through, limit), &mut removed)?;
+        let inserted = insert_unrecovering(cdt, pk, (&mut through, limit), &mut removed)?;
         match inserted {
             free::Inserted::Yes { .. } => {
                 done.push((inserted, removed));
@@ -274,12 +271,11 @@ pub(super) fn split_encroached(
 fn insert_unrecovering(
     cdt: &mut Cdt,
     (m, pert): (Point, u32),
-    at: &crate::mesh::VertexLists<VertexId>,
     (through, limit): (&mut Vec<usize>, usize),
     removed: &mut TakenOut,
 ) -> Result<free::Inserted, MeshError> {
     loop {
-        let inserted = free::insert_point(cdt, m, pert, at, true)?;
+        let inserted = free::insert_point(cdt, m, pert, true)?;
         let g = match &inserted {
             free::Inserted::Refused {
                 lost: None,
@@ -447,7 +443,6 @@ fn split_at(
     let mut through = facets_through(segs, &segments);
     let mut removed = take_out_subfaces(cdt, |f| through.contains(&(f as usize)));
     let markers: Vec<i32> = cut.iter().map(|&(e, ..)| segs.take_out(cdt, e)).collect();
-    let at = free::subsegment_ends(cdt);
     let limit = through.len() + MAX_UNRECOVERED;
     // All points go in, or none: each may remove the others' subsegments alone.
     let mut done: Vec<(VertexId, free::Inserted)> = Vec::with_capacity(at_r.len());
@@ -456,7 +451,6 @@ fn split_at(
         let inserted = insert_unrecovering(
             cdt,
             (m, pert + k as u32),
-            &at,
             (&mut through, limit),
             &mut removed,
         )?;

@@ -31,7 +31,7 @@ use crate::constrained::{PlcOptions, PlcStats};
 use crate::delaunay::Location;
 use crate::error::{Error, MeshError};
 use crate::geom::Point;
-use crate::mesh::{VertexId, VertexLists};
+use crate::mesh::VertexId;
 use crate::output::MeshOut;
 use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
@@ -106,10 +106,6 @@ pub struct Cdt {
     next_pert: u32,
     /// Steiner points added by insertions.
     added: usize,
-    /// The subsegments' ends by vertex, which a free point's insertion checks, made when
-    /// first needed and dropped whenever a subsegment changes (building them costs a
-    /// pass over all subsegments, far more than one insertion).
-    ends: Option<VertexLists<VertexId>>,
 }
 
 impl Cdt {
@@ -136,7 +132,6 @@ impl Cdt {
             warnings: c.warnings,
             next_pert,
             added: 0,
-            ends: None,
         })
     }
 
@@ -265,10 +260,7 @@ impl Cdt {
     /// A point that lands on no constraint and encroaches upon no subsegment: a walled
     /// cavity and flips; where the CDT refuses it, the constraint in the way is split.
     fn insert_free(&mut self, p: Point) -> Result<Step, InsertError> {
-        let at = self
-            .ends
-            .get_or_insert_with(|| free::subsegment_ends(&self.tets));
-        let inserted = free::insert_point(&mut self.tets, p, self.next_pert, at, true)
+        let inserted = free::insert_point(&mut self.tets, p, self.next_pert, true)
             .map_err(|_| InsertError::Refused(p))?;
         match inserted {
             free::Inserted::Yes { vertex, .. } => {

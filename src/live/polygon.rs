@@ -77,8 +77,6 @@ impl Cdt {
         self.split_log = Some(Vec::new());
         let done = self.try_insert_polygon(ring, marker);
         self.split_log = None;
-        // Its edges are new subsegments, or they are undone with the rest.
-        self.ends = None;
         if done.is_err() {
             self.tets = saved.tets;
             self.next_pert = saved.next_pert;
@@ -186,7 +184,6 @@ impl Cdt {
             }
             if self.tets.has_edge(u, v) {
                 self.tets.subsegs.insert(e, marker);
-                self.ends = None;
                 continue;
             }
             splits += 1;

@@ -476,8 +476,6 @@ impl Cdt {
                 _ => Err(InsertError::Refused(m)),
             };
         };
-        // The subsegments change (and may change back if the split is undone).
-        self.ends = None;
         let marker = split_edge.and_then(|e| self.tets.subsegs.remove(&e));
         if let (Some(k), Some((a, b))) = (marker, edge) {
             self.tets.subsegs.insert(edge_key(a, vertex), k);
@@ -527,8 +525,7 @@ impl Cdt {
         facets: &[u32],
         undo_tables: impl Fn(&mut Tets),
     ) -> Result<Result<(), [VertexId; 3]>, InsertError> {
-        let at = free::subsegment_ends(&self.tets);
-        let settled = free::settle(&mut self.tets, m, (vertex, change, last), &at, true)
+        let settled = free::settle(&mut self.tets, m, (vertex, change, last), true)
             .map_err(|_| InsertError::Refused(m))?;
         let in_way = match &settled {
             free::Inserted::Refused {
