@@ -262,13 +262,25 @@ pub(crate) fn construct(
         duplicate_points: base.duplicates.len(),
         ..Default::default()
     };
+    // Merged groups that cannot be triangulated in one plane are kept apart from the
+    // start (their segments' Steiner points can still make others so: see
+    // `Constructions::after_failure`).
+    let keep_apart = if opts.merge {
+        prepare::unflat_groups(plc, &base)
+    } else {
+        Vec::new()
+    };
+    let split = match keep_apart.is_empty() {
+        true => None,
+        false => Some(prepare::prepare_except(plc, opts.merge, &keep_apart)?),
+    };
     let mut run = Constructions {
         plc,
         opts,
         base: &base,
         merged,
-        split: None,
-        keep_apart: Vec::new(),
+        split,
+        keep_apart,
         first_dt: Some(first_dt),
         stats0: stats.clone(),
         stats,

@@ -16,6 +16,7 @@
 //!   both rings (3 or more vertices) of the same group.
 
 use crate::error::InputError;
+use crate::geom::facet2d::triangulate_facet;
 use crate::geom::norm;
 use crate::geom::polygon::representatives;
 pub(crate) use crate::geom::polygon::{all_collinear, dedup_ring, newell_normal};
@@ -121,6 +122,46 @@ impl Dsu {
             self.0[hi] = lo;
         }
     }
+}
+
+/// The input facets of the merged groups of `prep` (prepared from `plc`) that cannot be
+/// triangulated in one plane: their polygons, bent, overlap in its projection or cross
+/// their segments there. They are to be kept apart ([`prepare_except`]).
+pub fn unflat_groups(plc: &Plc, prep: &PreparedPlc) -> Vec<usize> {
+    let groups: Vec<&MergedFacet> = prep
+        .facets
+        .iter()
+        .filter(|f| f.source_facets.len() > 1 && !f.rings.is_empty())
+        .collect();
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let segments: FxHashSet<[u32; 2]> = prep.segments.iter().copied().collect();
+    // Input indices are the perturbation indices, as in meshing.
+    let pert: Vec<u32> = (0..plc.points.len() as u32).collect();
+    let mut out = Vec::new();
+    for f in groups {
+        let mut verts: Vec<u32> = f.isolated.clone();
+        let mut constraints: Vec<[u32; 2]> = f.inner_segments.clone();
+        for ring in &f.rings {
+            for k in 0..ring.len() {
+                let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+                verts.push(a);
+                let e = [a.min(b), a.max(b)];
+                if segments.contains(&e) {
+                    constraints.push(e);
+                }
+            }
+        }
+        verts.extend(f.inner_segments.iter().flatten());
+        verts.sort_unstable();
+        verts.dedup();
+        let tris = triangulate_facet(&plc.points, &pert, &verts, &constraints, &f.holes, f.normal);
+        if tris.is_err() {
+            out.extend(&f.source_facets);
+        }
+    }
+    out
 }
 
 /// Prepares a PLC for meshing: duplicate points, cleaned polygons, merged facets, segments.
@@ -721,5 +762,23 @@ mod tests {
         assert_eq!(q.facets.len(), (2 * k * k) as usize);
         assert_eq!(q.segments.len(), (3 * k * k + 2 * k) as usize);
         assert!(t0.elapsed().as_secs_f64() < 10.0);
+    }
+
+    /// `mpi.off` merges facets 27, 48 and 49 (0-based), bent by under 0.1°, whose
+    /// polygons overlap in their common plane: the group is found before meshing; the
+    /// flat faces of a box of 3x3 quads each merge into a group that is none.
+    #[test]
+    fn groups_that_cannot_be_triangulated_in_one_plane_are_found() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/plc/mpi.off");
+        let plc = crate::io::read_plc(&path).unwrap();
+        let prep = prepare(&plc, true).unwrap();
+        assert_eq!(unflat_groups(&plc, &prep), vec![27, 48, 49]);
+        let apart = prepare_except(&plc, true, &[27, 48, 49]).unwrap();
+        assert!(unflat_groups(&plc, &apart).is_empty());
+        let path = path.with_file_name("gridbox_3.smesh");
+        let grid = crate::io::read_plc(&path).unwrap();
+        let prep = prepare(&grid, true).unwrap();
+        assert!(prep.facets.iter().all(|f| f.source_facets.len() == 9));
+        assert!(unflat_groups(&grid, &prep).is_empty());
     }
 }
