@@ -39,6 +39,27 @@ fn with_cube_facets(mut plc: Plc) -> Plc {
     plc
 }
 
+/// A PLC of `points` with one facet for each polygon of `polygons`.
+fn polygons_plc(points: Vec<Point>, polygons: &[&[u32]]) -> Plc {
+    let mut plc = Plc::from_points(points, 0);
+    plc.facets = polygons
+        .iter()
+        .map(|p| Facet {
+            polygons: vec![p.to_vec()],
+            ..Default::default()
+        })
+        .collect();
+    plc
+}
+
+/// The shim test's verdict: whether tet 0 of `m` is listed as a shim of `plc`.
+fn tet_0_is_a_shim(plc: &Plc, m: &MeshOut) -> bool {
+    let e = check(plc, m).unwrap_err();
+    e.listed
+        .iter()
+        .any(|l| l.starts_with("tet 0 ") && l.contains("is a shim"))
+}
+
 fn meshed(plc: &Plc, p: bool) -> MeshOut {
     let opts = Options {
         plc: p,
@@ -274,7 +295,7 @@ fn a_segment_that_is_no_chain_of_edges_fails() {
 fn a_shim_fails() {
     // A square pyramid whose base is bent by 1e-4: the mesher's mesh passes, and the
     // same domain with a flat tet of the four base corners beneath two others fails.
-    let mut plc = Plc::from_points(
+    let plc = polygons_plc(
         vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -282,22 +303,14 @@ fn a_shim_fails() {
             [0.0, 1.0, -1e-4],
             [0.5, 0.5, 1.0],
         ],
-        0,
+        &[
+            &[0, 1, 2, 3],
+            &[0, 1, 4],
+            &[1, 2, 4],
+            &[2, 3, 4],
+            &[3, 0, 4],
+        ],
     );
-    let polygons = [
-        vec![0, 1, 2, 3],
-        vec![0, 1, 4],
-        vec![1, 2, 4],
-        vec![2, 3, 4],
-        vec![3, 0, 4],
-    ];
-    plc.facets = polygons
-        .into_iter()
-        .map(|p| Facet {
-            polygons: vec![p],
-            ..Default::default()
-        })
-        .collect();
     let mut m = meshed(&plc, true);
     check(&plc, &m).unwrap();
     m.tets = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 2, 3, 4]]
@@ -305,13 +318,7 @@ fn a_shim_fails() {
         .map(|t| oriented(&m.points, t))
         .collect();
     m.neighbors.clear();
-    let e = check(&plc, &m).unwrap_err();
-    assert!(
-        e.listed
-            .iter()
-            .any(|l| l.starts_with("tet 0 ") && l.contains("is a shim")),
-        "{e:?}"
-    );
+    assert!(tet_0_is_a_shim(&plc, &m));
 }
 
 #[test]
@@ -365,32 +372,19 @@ fn a_shim_with_a_steiner_point_in_a_facets_slab_fails() {
     // bottom's plane and box but outside the triangle lies on no facet by the nearest-
     // plane rule, yet in the bottom's slab, as the shared referee counts it: the flat
     // tet of the three bottom corners and that point is a shim.
-    let mut plc = Plc::from_points(
+    let plc = polygons_plc(
         vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],
             [0.2, 0.2, 1.0],
         ],
-        0,
+        &[&[0, 1, 2], &[0, 1, 3], &[1, 2, 3], &[2, 0, 3]],
     );
-    plc.facets = [[0, 1, 2], [0, 1, 3], [1, 2, 3], [2, 0, 3]]
-        .into_iter()
-        .map(|p| Facet {
-            polygons: vec![p.to_vec()],
-            ..Default::default()
-        })
-        .collect();
     let mut m = meshed(&plc, true);
     check(&plc, &m).unwrap();
     m.points.push([0.7, 0.7, 0.0]);
     m.tets.insert(0, oriented(&m.points, [0, 1, 2, 4]));
     m.neighbors.clear();
-    let e = check(&plc, &m).unwrap_err();
-    assert!(
-        e.listed
-            .iter()
-            .any(|l| l.starts_with("tet 0 ") && l.contains("is a shim")),
-        "{e:?}"
-    );
+    assert!(tet_0_is_a_shim(&plc, &m));
 }
