@@ -1,6 +1,7 @@
 //! Carving, the stage after facet recovery: the finished CDT's domain (the tets its
 //! subfaces enclose, with their regions) is kept and put in output form, with the
-//! subfaces and subsegments that bound it. It reads the CDT and changes nothing in it.
+//! subfaces and subsegments that bound it. It reads the CDT's tets and constraints and
+//! changes neither.
 
 use crate::constrained::cdt::Cdt;
 use crate::constrained::construction::Built;
@@ -14,8 +15,8 @@ use crate::plc::Plc;
 use crate::progress::{Progress, Stage};
 use std::time::Instant;
 
-/// Carves a copy of CDT `cdt` (whose subsegments are `seg_markers`) and puts it in
-/// output form.
+/// Carves a copy of CDT `cdt` (its subsegments with their markers) and puts it in output
+/// form.
 pub(crate) fn carve_copy(
     plc: &Plc,
     prep: &PreparedPlc,
