@@ -48,11 +48,7 @@ const RING_BVH: usize = 8;
 pub(super) struct Facet<'a> {
     pub src: &'a MergedFacet,
     proj: Projection,
-    normal: Point,
-    mean: Point,
-    /// Half the slab's thickness.
-    tol: f64,
-    bbox: Aabb,
+    slab: Slab,
     /// The rings as mesh nodes, whether each bounds a hole, whether each turns
     /// counterclockwise in the projection, and their projected boxes.
     rings: Vec<Vec<u32>>,
@@ -109,14 +105,61 @@ impl Facet<'_> {
         }
         None
     }
+}
 
-    /// The signed distance of `q` from the facet's plane.
+/// A facet's slab: its plane (through the mean of its vertices), half the slab's
+/// thickness, and the box of its vertices grown by that.
+#[derive(Clone, Copy)]
+struct Slab {
+    normal: Point,
+    mean: Point,
+    tol: f64,
+    bbox: Aabb,
+}
+
+impl Slab {
+    /// The slab of facet `f` (`node` maps its vertices to mesh nodes): empty if some of
+    /// them are missing from the mesh (reported apart: nothing lies on it).
+    fn of(f: &MergedFacet, node: &[u32], points: &[Point], diag: f64) -> Slab {
+        let mut verts: Vec<u32> = f
+            .rings
+            .iter()
+            .flatten()
+            .map(|&v| node[v as usize])
+            .collect();
+        if verts.is_empty() || verts.contains(&u32::MAX) {
+            return Slab {
+                normal: f.normal,
+                mean: [0.0; 3],
+                tol: -1.0,
+                bbox: [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]],
+            };
+        }
+        verts.sort_unstable();
+        verts.dedup();
+        let k = verts.len() as f64;
+        let mean: Point =
+            std::array::from_fn(|a| verts.iter().map(|&v| points[v as usize][a]).sum::<f64>() / k);
+        let dev = verts
+            .iter()
+            .map(|&v| dot(&sub(&points[v as usize], &mean), &f.normal).abs())
+            .fold(0.0, f64::max);
+        let tol = (MIN_SLAB * diag).max(4.0 * dev);
+        Slab {
+            normal: f.normal,
+            mean,
+            tol,
+            bbox: slab_box(&verts, points, tol),
+        }
+    }
+
+    /// The signed distance of `q` from the plane.
     fn height(&self, q: &Point) -> f64 {
         dot(&sub(q, &self.mean), &self.normal)
     }
 
-    /// Whether `q` lies within the facet's slab and box.
-    fn in_slab(&self, q: &Point) -> bool {
+    /// Whether `q` lies within the slab and its box.
+    fn holds(&self, q: &Point) -> bool {
         (0..3).all(|k| q[k] >= self.bbox[0][k] && q[k] <= self.bbox[1][k])
             && self.height(q).abs() <= self.tol
     }
@@ -234,7 +277,7 @@ pub(super) fn find(
         diag,
         facets: (0..prep.facets.len()).map(|_| None).collect(),
     };
-    let (on, simple, in_slabs) = nodes_on_facets(&mut geo, &chains, n_inputs);
+    let (on, simple, slab_rows) = nodes_on_facets(&mut geo, &chains, tets, n_inputs);
     let mut subfaces = FxHashMap::default();
     subfaces.reserve(faces.len() / 4);
     let mut has_faces = vec![false; prep.facets.len()];
@@ -278,7 +321,7 @@ pub(super) fn find(
             bare.push((g as u32, q));
         }
     }
-    shims(&in_slabs, points, tets, prep, pr);
+    shims(slab_rows.as_ref().unwrap_or(&on), points, tets, prep, pr);
     Constraints {
         chains,
         subfaces,
@@ -342,16 +385,12 @@ fn facet_geometry<'a>(f: &'a MergedFacet, node: &[u32], points: &[Point], diag: 
         .map(|r| r.iter().map(|&v| node[v as usize]).collect())
         .collect();
     let proj = Projection::along(&f.normal);
+    let slab = Slab::of(f, node, points, diag);
     if rings.iter().flatten().any(|&v| v == u32::MAX) {
-        // Its vertices are missing from the mesh, which is reported apart: nothing lies
-        // on it.
         return Facet {
             src: f,
             proj,
-            normal: f.normal,
-            mean: [0.0; 3],
-            tol: -1.0,
-            bbox: [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]],
+            slab,
             rings: Vec::new(),
             hole: Vec::new(),
             ccw: Vec::new(),
@@ -359,17 +398,6 @@ fn facet_geometry<'a>(f: &'a MergedFacet, node: &[u32], points: &[Point], diag: 
             ring_bvh: None,
         };
     }
-    let mut verts: Vec<u32> = rings.iter().flatten().copied().collect();
-    verts.sort_unstable();
-    verts.dedup();
-    let k = verts.len() as f64;
-    let mean: Point =
-        std::array::from_fn(|a| verts.iter().map(|&v| points[v as usize][a]).sum::<f64>() / k);
-    let dev = verts
-        .iter()
-        .map(|&v| dot(&sub(&points[v as usize], &mean), &f.normal).abs())
-        .fold(0.0, f64::max);
-    let tol = (MIN_SLAB * diag).max(4.0 * dev);
     // Projected boxes: queries ignore the dropped axis.
     let ax = proj.axis();
     let ring_boxes: Vec<Aabb> = rings
@@ -388,7 +416,6 @@ fn facet_geometry<'a>(f: &'a MergedFacet, node: &[u32], points: &[Point], diag: 
             b
         })
         .collect();
-    let bbox = slab_box(&verts, points, tol);
     let hole = crate::geom::polygon::hole_rings(points, &rings, &f.holes, &proj);
     let ccw = rings
         .iter()
@@ -398,10 +425,7 @@ fn facet_geometry<'a>(f: &'a MergedFacet, node: &[u32], points: &[Point], diag: 
     Facet {
         src: f,
         proj,
-        normal: f.normal,
-        mean,
-        tol,
-        bbox,
+        slab,
         rings,
         hole,
         ccw,
@@ -450,12 +474,14 @@ fn ring_is_ccw(ring: &[u32], proj: &Projection, points: &[Point]) -> bool {
 /// simple facets, which need none.
 ///
 /// Also, for the shim test, the facets each node lies on when a Steiner point lies on
-/// every facet whose slab and box hold it (the rows then list simple facets too).
+/// every facet whose slab and box hold it (the rows then list simple facets too), if
+/// they differ from the first rows.
 fn nodes_on_facets(
     geo: &mut Geometry,
     chains: &[Vec<u32>],
+    tets: &[[u32; 4]],
     n_inputs: usize,
-) -> (Rows, Vec<bool>, Rows) {
+) -> (Rows, Vec<bool>, Option<Rows>) {
     let (prep, node, points) = (geo.prep, geo.node, geo.points);
     let mut placed = vec![false; points.len()];
     for &v in node.iter().take(n_inputs) {
@@ -511,27 +537,41 @@ fn nodes_on_facets(
             is_input[v as usize] = true;
         }
     }
-    if (0..points.len()).any(|v| !is_input[v]) {
+    // The slabs that hold Steiner points matter for loose points, and for shims: only
+    // where a flat tet has a Steiner point.
+    let flat_with_steiner = || {
+        tets.par_iter().any(|tv| {
+            tv.iter().any(|&v| !is_input[v as usize]) && is_flat(&tv.map(|v| points[v as usize]))
+        })
+    };
+    if !loose.is_empty() || flat_with_steiner() {
         let with_rings: Vec<usize> = (0..prep.facets.len())
             .filter(|&g| !prep.facets[g].rings.is_empty() && norm(&prep.facets[g].normal) > 0.0)
             .collect();
-        let boxes: Vec<Aabb> = with_rings.iter().map(|&g| geo.facet(g).bbox).collect();
+        // The slabs alone: the facets' full geometry is made only for those whose slab
+        // holds a loose point.
+        let diag = geo.diag;
+        let slabs: Vec<Slab> = with_rings
+            .iter()
+            .map(|&g| Slab::of(&prep.facets[g], node, points, diag))
+            .collect();
+        let boxes: Vec<Aabb> = slabs.iter().map(|s| s.bbox).collect();
         let bvh = Bvh::build(&boxes);
         let mut near: Vec<usize> = Vec::new();
         for v in (0..points.len() as u32).filter(|&v| !is_input[v as usize]) {
             let p = &points[v as usize];
             near.clear();
-            bvh.query(&boxes, &[*p, *p], |i| near.push(with_rings[i]));
+            bvh.query(&boxes, &[*p, *p], |i| near.push(i));
             let loose = !placed[v as usize];
             let mut best: Option<(f64, usize)> = None;
-            for &g in &near {
-                let f = geo.facet(g);
-                if !f.in_slab(p) {
+            for &i in &near {
+                if !slabs[i].holds(p) {
                     continue;
                 }
+                let g = with_rings[i];
                 in_slabs.push((v, g as u32));
-                if loose && f.locate(points, p) != RingSide::Outside {
-                    let d = f.height(p).abs();
+                if loose && geo.facet(g).locate(points, p) != RingSide::Outside {
+                    let d = slabs[i].height(p).abs();
                     if best.is_none_or(|(b, _)| d < b) {
                         best = Some((d, g));
                     }
@@ -563,29 +603,37 @@ fn nodes_on_facets(
             }
         }
     }
-    // The facets that Steiner points lie in the slabs of, with their own vertices.
-    let mut with_slab_nodes: Vec<u32> = in_slabs.iter().map(|&(_, g)| g).collect();
-    with_slab_nodes.sort_unstable();
-    with_slab_nodes.dedup();
-    let mut shim_pairs = in_slabs;
-    shim_pairs.extend(pairs.iter().copied());
-    for &g in &with_slab_nodes {
-        let f = &prep.facets[g as usize];
-        for &v in f.rings.iter().flatten().chain(&f.isolated) {
-            let x = node[v as usize];
-            if x != u32::MAX {
-                shim_pairs.push((x, g));
-            }
-        }
-    }
     pairs.sort_unstable();
     pairs.dedup();
-    shim_pairs.sort_unstable();
-    shim_pairs.dedup();
+    // For the shim test: the Steiner points in slabs of facets they are not on, and
+    // then every node on those facets. Few or none: such a point lies near nearly
+    // coplanar neighbouring facets.
+    let mut extra: Vec<(u32, u32)> = in_slabs
+        .into_iter()
+        .filter(|e| pairs.binary_search(e).is_err())
+        .collect();
+    let shim_rows = (!extra.is_empty()).then(|| {
+        let mut facets: Vec<u32> = extra.iter().map(|&(_, g)| g).collect();
+        facets.sort_unstable();
+        facets.dedup();
+        for &g in &facets {
+            let f = &prep.facets[g as usize];
+            for &v in f.rings.iter().flatten().chain(&f.isolated) {
+                let x = node[v as usize];
+                if x != u32::MAX {
+                    extra.push((x, g));
+                }
+            }
+        }
+        extra.extend(pairs.iter().copied());
+        extra.sort_unstable();
+        extra.dedup();
+        Rows::new(points.len(), extra.into_iter())
+    });
     (
         Rows::new(points.len(), pairs.into_iter()),
         simple,
-        Rows::new(points.len(), shim_pairs.into_iter()),
+        shim_rows,
     )
 }
 
@@ -700,7 +748,7 @@ fn candidates(
             let centroid: Point = std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0);
             if fa.locate(points, &centroid) != RingSide::Outside {
                 let n = cross(&sub(p[1], p[0]), &sub(p[2], p[0]));
-                let tilt = 1.0 - (dot(&n, &fa.normal) / norm(&n)).abs();
+                let tilt = 1.0 - (dot(&n, &fa.slab.normal) / norm(&n)).abs();
                 let f = if o > 0.0 { f } else { [f[0], f[2], f[1]] };
                 out.push((g, Cand { f, tilt }));
             }

@@ -252,7 +252,7 @@ pub(crate) fn construct(
     progress: Progress<'_>,
 ) -> Result<Constructed, Error> {
     progress(Stage::Delaunay);
-    let ((base, all_merged), first_dt) = prepare_beside_delaunay(plc, opts)?;
+    let ((base, all_merged, (keep_apart, split)), first_dt) = prepare_beside_delaunay(plc, opts)?;
     let merged = all_merged.as_ref().unwrap_or(&base);
     let mut warnings = duplicate_warnings(plc, &base);
     let stats = PlcStats {
@@ -261,18 +261,6 @@ pub(crate) fn construct(
         input_polygons: plc.facets.iter().map(|f| f.polygons.len()).sum(),
         duplicate_points: base.duplicates.len(),
         ..Default::default()
-    };
-    // Merged groups that cannot be triangulated in one plane are kept apart from the
-    // start (their segments' Steiner points can still make others so: see
-    // `Constructions::after_failure`).
-    let keep_apart = if opts.merge {
-        prepare::unflat_groups(plc, &base)
-    } else {
-        Vec::new()
-    };
-    let split = match keep_apart.is_empty() {
-        true => None,
-        false => Some(prepare::prepare_except(plc, opts.merge, &keep_apart)?),
     };
     let mut run = Constructions {
         plc,
@@ -615,13 +603,22 @@ impl Constructions<'_> {
     }
 }
 
-/// The PLC as meshed, and (without merging) as prepared with every group merged.
-type Prepared = (PreparedPlc, Option<PreparedPlc>);
+/// The PLC as prepared; (without merging) as prepared with every group merged; and the
+/// input facets of merged groups that cannot be triangulated in one plane, with the PLC
+/// prepared again with them kept apart, if there are any.
+type Prepared = (
+    PreparedPlc,
+    Option<PreparedPlc>,
+    (Vec<usize>, Option<PreparedPlc>),
+);
 
 /// The PLC prepared (and, without merging, prepared again with every coplanar group
-/// merged, on which flat tets are judged) and its first Delaunay tetrahedralization with
-/// its time: they do not depend on each other, and run on two cores. An open surface is
-/// found once prepared (the Delaunay stage then stops early) and refused.
+/// merged, on which flat tets are judged; with merging, the groups that cannot be
+/// triangulated in one plane are kept apart from the start: their segments' Steiner
+/// points can still make others so, see `Constructions::after_failure`) and its first
+/// Delaunay tetrahedralization with its time: they do not depend on each other, and run
+/// on two cores. An open surface is found once prepared (the Delaunay stage then stops
+/// early) and refused.
 fn prepare_beside_delaunay(
     plc: &Plc,
     opts: &PlcOptions,
@@ -648,7 +645,16 @@ fn prepare_beside_delaunay(
             } else {
                 Some(prepare(plc, true)?)
             };
-            Ok((base, all_merged))
+            let keep_apart = if opts.merge {
+                prepare::unflat_groups(plc, &base)
+            } else {
+                Vec::new()
+            };
+            let split = match keep_apart.is_empty() {
+                true => None,
+                false => Some(prepare::prepare_except(plc, opts.merge, &keep_apart)?),
+            };
+            Ok((base, all_merged, (keep_apart, split)))
         });
         let t0 = Instant::now();
         let dt =

@@ -196,8 +196,17 @@ pub fn representatives(points: &[Point]) -> Vec<u32> {
 /// Polygon `poly` with its vertices replaced by their representatives `rep`, without
 /// repeated consecutive vertices (also across the wrap).
 pub fn clean_ring(poly: &[u32], rep: &[u32]) -> Vec<u32> {
-    let mapped: Vec<u32> = poly.iter().map(|&v| rep[v as usize]).collect();
-    dedup_ring(&mapped)
+    let mut out: Vec<u32> = Vec::with_capacity(poly.len());
+    for &v in poly {
+        let r = rep[v as usize];
+        if out.last() != Some(&r) {
+            out.push(r);
+        }
+    }
+    while out.len() > 1 && out[0] == out[out.len() - 1] {
+        out.pop();
+    }
+    out
 }
 
 #[cfg(test)]
