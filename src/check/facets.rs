@@ -483,12 +483,13 @@ fn nodes_on_facets(
     n_inputs: usize,
 ) -> (Rows, Vec<bool>, Option<Rows>) {
     let (prep, node, points) = (geo.prep, geo.node, geo.points);
-    let mut placed = vec![false; points.len()];
+    let mut is_input = vec![false; points.len()];
     for &v in node.iter().take(n_inputs) {
         if v != u32::MAX {
-            placed[v as usize] = true;
+            is_input[v as usize] = true;
         }
     }
+    let mut placed = is_input.clone();
     let mut simple: Vec<bool> = prep
         .facets
         .iter()
@@ -531,12 +532,6 @@ fn nodes_on_facets(
     let mut in_slab: Vec<(u32, u32)> = Vec::new();
     // Every Steiner point with every facet whose slab and box hold it.
     let mut in_slabs: Vec<(u32, u32)> = Vec::new();
-    let mut is_input = vec![false; points.len()];
-    for &v in node.iter().take(n_inputs) {
-        if v != u32::MAX {
-            is_input[v as usize] = true;
-        }
-    }
     // The slabs that hold Steiner points matter for loose points, and for shims: only
     // where a flat tet has a Steiner point.
     let flat_with_steiner = || {

@@ -7,8 +7,13 @@ use rustc_hash::FxHashMap;
 
 /// Drops repeated consecutive vertices, also across the wrap.
 pub fn dedup_ring(poly: &[u32]) -> Vec<u32> {
-    let mut out: Vec<u32> = Vec::with_capacity(poly.len());
-    for &v in poly {
+    without_repeats(poly.iter().copied())
+}
+
+/// The ring `vs` without repeated consecutive vertices, also across the wrap.
+fn without_repeats(vs: impl ExactSizeIterator<Item = u32>) -> Vec<u32> {
+    let mut out: Vec<u32> = Vec::with_capacity(vs.len());
+    for v in vs {
         if out.last() != Some(&v) {
             out.push(v);
         }
@@ -196,17 +201,7 @@ pub fn representatives(points: &[Point]) -> Vec<u32> {
 /// Polygon `poly` with its vertices replaced by their representatives `rep`, without
 /// repeated consecutive vertices (also across the wrap).
 pub fn clean_ring(poly: &[u32], rep: &[u32]) -> Vec<u32> {
-    let mut out: Vec<u32> = Vec::with_capacity(poly.len());
-    for &v in poly {
-        let r = rep[v as usize];
-        if out.last() != Some(&r) {
-            out.push(r);
-        }
-    }
-    while out.len() > 1 && out[0] == out[out.len() - 1] {
-        out.pop();
-    }
-    out
+    without_repeats(poly.iter().map(|&v| rep[v as usize]))
 }
 
 #[cfg(test)]
