@@ -74,7 +74,37 @@ pub struct Options {
     /// `-J`: keep the input points that are in no tet (duplicates, points outside the
     /// domain or in holes) in the output, instead of dropping them as TetGen does.
     pub keep_unused: bool,
+    /// `-q[ratio][/angle]`: refine until no tet exceeds the radius-edge ratio (or has a
+    /// dihedral angle under the angle); needs `-p`.
+    pub quality: Option<QualityBounds>,
+    /// `-a<vol>`: no tet larger than this volume; needs `-p`.
+    pub max_volume: Option<f64>,
+    /// `-a` without a number: the volume bounds of the `.poly` file's regions; needs `-p`.
+    pub region_volumes: bool,
 }
+
+/// The bounds of `-q`: TetGen's defaults are a radius-edge ratio of 2 and no dihedral
+/// bound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QualityBounds {
+    /// The largest radius-edge ratio a tet may have.
+    pub max_ratio: f64,
+    /// The smallest dihedral angle a tet may have, in degrees (0: no bound).
+    pub min_dihedral: f64,
+}
+
+impl Default for QualityBounds {
+    fn default() -> Self {
+        QualityBounds {
+            max_ratio: 2.0,
+            min_dihedral: 0.0,
+        }
+    }
+}
+
+/// The dihedral angles of a regular tet, `acos(1/3)` in degrees: no tet has a smallest
+/// dihedral angle above it, so a `-q` angle bound must stay below.
+pub const REGULAR_DIHEDRAL: f64 = 70.528_779_365_509_31;
 
 /// One thing wrong with the switches.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -179,8 +209,6 @@ enum Arg {
 
 /// A TetGen switch we recognise but refuse: letter, argument, description.
 const REFUSED: &[(char, Arg, &str)] = &[
-    ('q', Arg::Numbers, "quality mesh generation"),
-    ('a', Arg::Numbers, "maximum volume constraint"),
     ('r', Arg::None, "reconstruct a previous mesh"),
     ('Y', Arg::Numbers, "preserve the input surface mesh"),
     ('i', Arg::None, "insert additional points"),
@@ -218,6 +246,8 @@ const NEED_PLC: &[(char, &str)] = &[
     ('M', "no merging of coplanar facets"),
     ('c', "convex hull retention"),
     ('A', "region attributes"),
+    ('q', "quality mesh generation"),
+    ('a', "maximum volume constraint"),
 ];
 
 /// What the parser noticed across all switch strings, for the checks made at the end.
@@ -228,6 +258,8 @@ struct Seen {
     no_merge: bool,
     keep_hull: bool,
     regions: bool,
+    quality: bool,
+    volume: bool,
     jettison: bool,
     problems: Vec<SwitchProblem>,
 }
@@ -387,6 +419,32 @@ impl Options {
                         });
                     }
                 }
+                'q' => {
+                    let num = take_numbers(&chars, &mut i);
+                    seen.quality = true;
+                    match parse_quality(&num) {
+                        Some(q) => self.quality = Some(q),
+                        None => seen.problems.push(SwitchProblem::BadArgument {
+                            switch: 'q',
+                            text: num,
+                        }),
+                    }
+                }
+                'a' => {
+                    let num = take_numbers(&chars, &mut i);
+                    seen.volume = true;
+                    if num.is_empty() {
+                        self.region_volumes = true;
+                    } else {
+                        match num.parse::<f64>() {
+                            Ok(v) if v > 0.0 && v.is_finite() => self.max_volume = Some(v),
+                            _ => seen.problems.push(SwitchProblem::BadArgument {
+                                switch: 'a',
+                                text: num,
+                            }),
+                        }
+                    }
+                }
                 'o' => {
                     let num = take_numbers(&chars, &mut i);
                     if num.is_empty() {
@@ -454,6 +512,8 @@ impl Options {
                     'F' => seen.flip,
                     'M' => seen.no_merge,
                     'c' => seen.keep_hull,
+                    'q' => seen.quality,
+                    'a' => seen.volume,
                     _ => seen.regions,
                 };
                 if given {
@@ -481,6 +541,29 @@ impl Options {
             })
         }
     }
+}
+
+/// The bounds of `-q` from its argument (`""`, `1.414`, `1.2/15`, `/15`): a positive
+/// ratio, and an angle from 0 up to (not including) a regular tet's; `None` if malformed.
+fn parse_quality(num: &str) -> Option<QualityBounds> {
+    let mut q = QualityBounds::default();
+    let mut parts = num.split('/');
+    let ratio = parts.next().unwrap_or("");
+    if !ratio.is_empty() {
+        q.max_ratio = ratio
+            .parse()
+            .ok()
+            .filter(|&r: &f64| r > 0.0 && r.is_finite())?;
+    }
+    if let Some(angle) = parts.next() {
+        if !angle.is_empty() {
+            q.min_dihedral = angle
+                .parse()
+                .ok()
+                .filter(|&a: &f64| (0.0..REGULAR_DIHEDRAL).contains(&a))?;
+        }
+    }
+    parts.next().is_none().then_some(q)
 }
 
 /// Consumes the numeric argument starting at `chars[*i]`: a number (digits, `.`, and an
@@ -661,15 +744,14 @@ mod tests {
     fn refused_switches_name_themselves() {
         // (switches, substrings the message must contain)
         let table: &[(&[&str], &[&str])] = &[
-            (
-                &["-q"],
-                &["-q (quality mesh generation) is not implemented"],
-            ),
-            (&["-q1.2"], &["-q1.2 (quality"]),
-            (&["-q1.2/15"], &["-q1.2/15 (quality"]),
-            (&["-a"], &["-a (maximum volume"]),
-            (&["-a0.5"], &["-a0.5 (maximum volume"]),
-            (&["-a1e-3"], &["-a1e-3 (maximum volume"]),
+            (&["-q"], &["-q (quality mesh generation) needs -p"]),
+            (&["-q1.2/15"], &["-q (quality mesh generation) needs -p"]),
+            (&["-a0.5"], &["-a (maximum volume constraint) needs -p"]),
+            (&["-pq0"], &["-q does not take the argument \"0\""]),
+            (&["-pq1/80"], &["-q does not take the argument \"1/80\""]),
+            (&["-pq1/2/3"], &["-q does not take the argument \"1/2/3\""]),
+            (&["-pa0"], &["-a does not take the argument \"0\""]),
+            (&["-pa1/2"], &["-a does not take the argument \"1/2\""]),
             (&["-r"], &["-r (reconstruct"]),
             (&["-Y"], &["-Y (preserve"]),
             (&["-A"], &["-A (region attributes) needs -p"]),
@@ -735,11 +817,11 @@ mod tests {
     fn numbers_do_not_swallow_following_switches() {
         // Every problem of the string is reported, so the later letters must parse.
         let table: &[(&str, &[&str])] = &[
-            ("-pq1.2a0.5", &["-q1.2 (", "-a0.5 ("]),
-            ("-q1.2/15zy", &["-q1.2/15 (", "unknown switch -y"]),
-            ("-q1.2e", &["-q1.2 ("]),
-            ("-a.5T1e+3S10K", &["-a.5 (", "-T1e+3 (", "-K ("]),
-            ("-O2/7Vq", &["-O2/7 (", "-q ("]),
+            ("-pq1.2a0.5r", &["-r ("]),
+            ("-pq1.2/15zy", &["unknown switch -y"]),
+            ("-q1.2e", &["-q (quality mesh generation) needs -p"]),
+            ("-pa.5T1e+3S10K", &["-T1e+3 (", "-K ("]),
+            ("-O2/7Vpq", &["-O2/7 ("]),
         ];
         for (s, wants) in table {
             let e = Options::from_switches([*s]).unwrap_err();
@@ -751,8 +833,27 @@ mod tests {
         }
         // `-q1.2e`: the `e` after the number is the edge switch, not an exponent.
         let mut o = Options::default();
-        assert!(o.apply_switches(["-q1.2e"]).is_err());
+        assert!(o.apply_switches(["-pq1.2e"]).is_ok());
         assert!(o.write_edges);
+        assert_eq!(o.quality.unwrap().max_ratio, 1.2);
+    }
+
+    #[test]
+    fn quality_and_volume_bounds() {
+        let q = |s: &str| ok(&[s]).quality.unwrap();
+        assert_eq!(q("-pq"), QualityBounds::default());
+        assert_eq!(q("-pq").max_ratio, 2.0);
+        assert_eq!(q("-pq1.414").max_ratio, 1.414);
+        let b = q("-pq1.2/15");
+        assert_eq!((b.max_ratio, b.min_dihedral), (1.2, 15.0));
+        let b = q("-pq/10");
+        assert_eq!((b.max_ratio, b.min_dihedral), (2.0, 10.0));
+        assert_eq!(ok(&["-p"]).quality, None);
+        let o = ok(&["-pa0.5"]);
+        assert_eq!((o.max_volume, o.region_volumes), (Some(0.5), false));
+        let o = ok(&["-pa", "-a1e-3A"]);
+        assert_eq!((o.max_volume, o.region_volumes), (Some(1e-3), true));
+        assert!(o.region_attributes);
     }
 
     #[test]

@@ -5,6 +5,7 @@
 use crate::constrained::{construct, Constructed, PlcOptions, PlcStats};
 use crate::delaunay::Delaunay;
 use crate::error::{Error, MeshError};
+use crate::live::RefineParameters;
 use crate::options::Options;
 use crate::output::MeshOut;
 use crate::plc::prepare::PreparedPlc;
@@ -120,7 +121,13 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             wake_when_prepared: Some(checker.thread().clone()),
             ..popts
         };
-        let done = mesh_plc_with_progress(plc, &popts, progress);
+        let refine = RefineParameters {
+            max_ratio: opts.quality.map(|q| q.max_ratio),
+            min_dihedral: opts.quality.map(|q| q.min_dihedral),
+            max_volume: opts.max_volume,
+            region_volumes: opts.region_volumes,
+        };
+        let done = mesh_plc_with_progress(plc, &popts, (&refine, opts.max_steiner), progress);
         checker.thread().unpark();
         let checked = checker
             .join()
@@ -144,6 +151,13 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
     let certify_secs = t_certify.elapsed().as_secs_f64();
     warnings.extend(done.warnings);
     let ps = done.stats;
+    let wants_quality = opts.verbose > 0
+        || opts.stats_json.is_some()
+        || opts.quality.is_some()
+        || opts.max_volume.is_some()
+        || opts.region_volumes;
+    let quality =
+        wants_quality.then(|| crate::stats::QualityFigures::of(&done.mesh.points, &done.mesh.tets));
     let stats = Stats {
         input_points: plc.points.len(),
         duplicate_points: ps.duplicate_points,
@@ -153,6 +167,7 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
         certify_secs,
         total_secs: start.elapsed().as_secs_f64(),
         plc: Some(ps),
+        quality,
         ..Default::default()
     };
     Ok(Meshed {
@@ -177,22 +192,29 @@ pub struct PlcMesh {
 
 /// Meshes a PLC: its constrained Delaunay tetrahedralization, carved.
 pub fn mesh_plc(plc: &Plc, opts: &PlcOptions) -> Result<PlcMesh, Error> {
-    mesh_plc_with_progress(plc, opts, &crate::progress::no_progress)
+    let no = RefineParameters::default();
+    mesh_plc_with_progress(plc, opts, (&no, None), &crate::progress::no_progress)
 }
 
-/// Like [`mesh_plc`], telling `progress` when each stage begins.
+/// Like [`mesh_plc`], refined to `refine.0` (with the Steiner point budget `refine.1`,
+/// none if `None`), telling `progress` when each stage begins.
 pub fn mesh_plc_with_progress(
     plc: &Plc,
     opts: &PlcOptions,
+    refine: (&RefineParameters, Option<usize>),
     progress: Progress<'_>,
 ) -> Result<PlcMesh, Error> {
+    let constructed = construct(plc, opts, progress)?;
+    if refine.0.any() {
+        return refined(plc, opts, constructed, refine, progress);
+    }
     let Constructed {
         built,
         split,
         base,
         mut stats,
         warnings,
-    } = construct(plc, opts, progress)?;
+    } = constructed;
     let prep = split.as_ref().unwrap_or(&base);
     let mesh = crate::carve::carve(plc, prep, *built, opts, &mut stats, progress)?;
     Ok(PlcMesh {
@@ -200,5 +222,39 @@ pub fn mesh_plc_with_progress(
         stats,
         warnings,
         prepared: base,
+    })
+}
+
+/// The refinement stage: the finished CDT, live, refined in place, then carved.
+fn refined(
+    plc: &Plc,
+    opts: &PlcOptions,
+    constructed: Constructed,
+    (params, budget): (&RefineParameters, Option<usize>),
+    progress: Progress<'_>,
+) -> Result<PlcMesh, Error> {
+    progress(Stage::Refine);
+    let t = Instant::now();
+    let mut cdt = crate::live::Cdt::of_construction(plc, opts, constructed);
+    // Refinement ends by its own argument (ARCHITECTURE.md): only `-S` bounds it.
+    cdt.set_steiner_budget(budget.unwrap_or(usize::MAX));
+    let r = cdt.refine(params);
+    let secs = t.elapsed().as_secs_f64();
+    let (mesh, prepared, mut stats, mut warnings) = cdt.into_mesh(progress)?;
+    stats.refine_points = r.points;
+    stats.refine_left = r.left;
+    stats.refine_secs = secs;
+    if r.budget_spent {
+        warnings.push(format!(
+            "the Steiner point budget (-S) ran out during refinement: {} tets are still over \
+             the quality bounds",
+            r.left
+        ));
+    }
+    Ok(PlcMesh {
+        mesh,
+        stats,
+        warnings,
+        prepared,
     })
 }

@@ -19,6 +19,8 @@ pub enum Stage {
     Segments,
     /// Recovering the facets (`-p`).
     Facets,
+    /// Quality refinement (`-q`, `-a`).
+    Refine,
     /// Removing the exterior and the holes (`-p`).
     Carve,
     /// Writing the output files.
@@ -33,6 +35,7 @@ impl Stage {
             Stage::Delaunay => "Delaunay",
             Stage::Segments => "segments",
             Stage::Facets => "facets",
+            Stage::Refine => "refine",
             Stage::Carve => "carve",
             Stage::Write => "write",
         }

@@ -23,6 +23,87 @@ pub struct Stats {
     pub total_secs: f64,
     /// The figures of PLC meshing (`-p`), the rows of the paper's Table 1.
     pub plc: Option<crate::constrained::PlcStats>,
+    /// The shapes of the output tets (with `-V`, `--stats-json`, `-q` or `-a`).
+    pub quality: Option<QualityFigures>,
+}
+
+/// The upper ends of the dihedral-angle histogram's bins, in degrees, as TetGen prints
+/// them (the first bin starts at 0).
+pub const DIHEDRAL_BINS: [f64; 18] = [
+    5.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 110.0, 120.0, 130.0, 140.0, 150.0, 160.0,
+    170.0, 175.0, 180.0,
+];
+
+/// The shape figures of a mesh: its worst radius-edge ratio and its dihedral angles.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct QualityFigures {
+    /// The largest radius-edge ratio of a tet.
+    pub max_ratio: f64,
+    /// The smallest dihedral angle, in degrees.
+    pub min_dihedral: f64,
+    /// The largest dihedral angle, in degrees.
+    pub max_dihedral: f64,
+    /// The smallest and the largest tet volume.
+    pub volume_range: (f64, f64),
+    /// Dihedral angles (six per tet) per bin of [`DIHEDRAL_BINS`].
+    pub dihedral_histogram: [usize; 18],
+}
+
+impl QualityFigures {
+    /// The figures of the tets `tets` (indices into `points`, from 0).
+    pub fn of(points: &[crate::geom::Point], tets: &[[u32; 4]]) -> QualityFigures {
+        use crate::geom::quality;
+        let mut q = QualityFigures {
+            min_dihedral: 180.0,
+            volume_range: (f64::INFINITY, 0.0),
+            ..Default::default()
+        };
+        for t in tets {
+            let p = t.map(|v| points[v as usize]);
+            q.max_ratio = q.max_ratio.max(quality::radius_edge_ratio(&p));
+            let vol = quality::volume(&p);
+            q.volume_range = (q.volume_range.0.min(vol), q.volume_range.1.max(vol));
+            for a in quality::dihedral_angles(&p) {
+                q.min_dihedral = q.min_dihedral.min(a);
+                q.max_dihedral = q.max_dihedral.max(a);
+                let bin = DIHEDRAL_BINS.iter().position(|&hi| a < hi).unwrap_or(17);
+                q.dihedral_histogram[bin] += 1;
+            }
+        }
+        if tets.is_empty() {
+            q.min_dihedral = 0.0;
+            q.volume_range = (0.0, 0.0);
+        }
+        q
+    }
+
+    /// The figures as `-V` prints them, one line each.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = vec![
+            format!("Largest radius-edge ratio: {:.6}", self.max_ratio),
+            format!(
+                "Smallest / largest dihedral angle: {:.4} / {:.4} degrees",
+                self.min_dihedral, self.max_dihedral
+            ),
+            format!(
+                "Smallest / largest volume: {:e} / {:e}",
+                self.volume_range.0, self.volume_range.1
+            ),
+            "Dihedral angle histogram:".to_string(),
+        ];
+        // Two columns, as TetGen prints it: the first nine bins on the left.
+        let label = |i: usize| {
+            let lo = if i == 0 { 0.0 } else { DIHEDRAL_BINS[i - 1] };
+            format!(
+                "{lo:>5} - {:>3} degrees: {:>10}",
+                DIHEDRAL_BINS[i], self.dihedral_histogram[i]
+            )
+        };
+        for i in 0..9 {
+            out.push(format!("  {}   |  {}", label(i), label(i + 9)));
+        }
+        out
+    }
 }
 
 impl Stats {
@@ -157,6 +238,15 @@ impl Stats {
                 "(14) facet recovery seconds",
                 format!("{:.6}", p.facet_secs),
             ),
+            (
+                "    quality refinement: points added",
+                p.refine_points.to_string(),
+            ),
+            (
+                "    tets left over the bounds (small angles)",
+                p.refine_left.to_string(),
+            ),
+            ("    refinement seconds", format!("{:.6}", p.refine_secs)),
             ("    carving seconds", format!("{:.6}", p.carve_secs)),
             ("(16) total CDT seconds", format!("{:.6}", self.total_secs)),
         ]);
@@ -174,8 +264,25 @@ impl Stats {
             ("certify_secs".into(), json_f64(self.certify_secs)),
             ("total_secs".into(), json_f64(self.total_secs)),
         ];
+        if let Some(q) = &self.quality {
+            let hist: Vec<String> = q.dihedral_histogram.iter().map(|n| n.to_string()).collect();
+            fields.extend([
+                ("max_radius_edge_ratio".into(), json_f64(q.max_ratio)),
+                ("min_dihedral".into(), json_f64(q.min_dihedral)),
+                ("max_dihedral".into(), json_f64(q.max_dihedral)),
+                ("min_volume".into(), json_f64(q.volume_range.0)),
+                ("max_volume".into(), json_f64(q.volume_range.1)),
+                (
+                    "dihedral_histogram".into(),
+                    format!("[{}]", hist.join(", ")),
+                ),
+            ]);
+        }
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 23] = [
+            let pairs: [(&str, String); 26] = [
+                ("refine_points", p.refine_points.to_string()),
+                ("refine_left", p.refine_left.to_string()),
+                ("refine_secs", json_f64(p.refine_secs)),
                 ("input_polygons", p.input_polygons.to_string()),
                 ("steiner_points", p.steiner_points.to_string()),
                 ("facet_steiner_points", p.facet_steiner_points.to_string()),

@@ -65,13 +65,16 @@ fn usage_errors_exit_2_naming_the_switch() {
         ),
         (
             &["-q1.2", "p.node"],
-            "switch -q1.2 (quality mesh generation) is not implemented",
+            "switch -q (quality mesh generation) needs -p",
         ),
         (
             &["-a", "p.node"],
-            "switch -a (maximum volume constraint) is not implemented",
+            "switch -a (maximum volume constraint) needs -p",
         ),
-        (&["-a0.5", "p.node"], "switch -a0.5 (maximum volume"),
+        (
+            &["-pa0", "p.node"],
+            "switch -a does not take the argument \"0\"",
+        ),
         (&["-y", "p.node"], "unknown switch -y"),
         (&["-zy", "p.node"], "unknown switch -y"),
         (
@@ -124,9 +127,13 @@ fn usage_errors_exit_2_naming_the_switch() {
 fn every_problem_of_a_switch_string_is_reported() {
     let dir = tempfile::tempdir().unwrap();
     write_points(&dir.path().join("p.node"), 8, 1);
-    let (code, _, stderr) = run_in(dir.path(), &["-pq1.2/15a0.5yV", "p.node"]);
+    let (code, _, stderr) = run_in(dir.path(), &["-pq1.2/95a0.5ryV", "p.node"]);
     assert_eq!(code, 2);
-    for want in ["-q1.2/15 (", "-a0.5 (", "unknown switch -y"] {
+    for want in [
+        "-q does not take the argument \"1.2/95\"",
+        "-r (",
+        "unknown switch -y",
+    ] {
         assert!(stderr.contains(want), "{stderr:?} lacks {want:?}");
     }
 }

@@ -699,7 +699,13 @@ fn steiner_bound_exits_1_with_the_reason() {
 
 #[test]
 fn usage_and_io_errors() {
-    refused("crossing_facets.poly", &["-pq"], 2, &["-q (quality"]);
+    refused("crossing_facets.poly", &["-pr"], 2, &["-r (reconstruct"]);
+    refused(
+        "crossing_facets.poly",
+        &["-q"],
+        2,
+        &["-q (quality mesh generation) needs -p"],
+    );
     refused(
         "crossing_facets.poly",
         &["-d", "--check"],

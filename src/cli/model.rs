@@ -287,6 +287,13 @@ fn print_statistics(say: &Say<'_>, meshed: &tetcdt::Meshed, mesh_points: usize) 
     say!(say, "  Certify seconds: {}", s.certify_secs);
     say!(say, "  Delaunay seconds: {}", s.delaunay_secs);
     say!(say, "  Meshing seconds: {}", s.total_secs);
+    if let Some(q) = &s.quality {
+        say!(say, "");
+        say!(say, "  Mesh quality:");
+        for line in q.lines() {
+            say!(say, "    {line}");
+        }
+    }
     let rows = s.table1_rows();
     if !rows.is_empty() {
         say!(say, "");

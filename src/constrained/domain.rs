@@ -15,7 +15,13 @@ pub struct Domain {
     pub tets: Vec<TetId>,
     /// The region attribute of each kept tet (0 where no region point reaches).
     pub attributes: Vec<f64>,
+    /// The region (index in the PLC's list) of each kept tet, [`NO_REGION`] where no
+    /// region point reaches.
+    pub regions: Vec<u32>,
 }
+
+/// [`Domain::regions`] of a tet that no region point reaches.
+pub const NO_REGION: u32 = u32::MAX;
 
 impl Domain {
     /// Per tet slot (of `slots`), whether the tet is kept.
@@ -52,8 +58,9 @@ pub fn domain(cdt: &mut Cdt, holes: &[Point], regions: &[Region], keep_hull: boo
         }
     }
     let mut attr = vec![0.0f64; slots];
+    let mut region = vec![NO_REGION; slots];
     let mut seen = vec![false; slots];
-    for r in regions {
+    for (ri, r) in regions.iter().enumerate() {
         let Some(t) = containing_tet(cdt, &r.point) else {
             continue;
         };
@@ -67,6 +74,7 @@ pub fn domain(cdt: &mut Cdt, holes: &[Point], regions: &[Region], keep_hull: boo
         seen[t as usize] = true;
         while let Some(t) = stack.pop() {
             attr[t as usize] = r.attribute;
+            region[t as usize] = ri as u32;
             for i in 0..4 {
                 if cdt.is_subface(t, i) {
                     continue;
@@ -86,7 +94,12 @@ pub fn domain(cdt: &mut Cdt, holes: &[Point], regions: &[Region], keep_hull: boo
         .filter(|&t| !removed[t as usize])
         .collect();
     let attributes = tets.iter().map(|&t| attr[t as usize]).collect();
-    Domain { tets, attributes }
+    let regions = tets.iter().map(|&t| region[t as usize]).collect();
+    Domain {
+        tets,
+        attributes,
+        regions,
+    }
 }
 
 /// Marks as removed everything reachable from `stack` without crossing a subface.
@@ -203,7 +216,8 @@ mod tests {
             max_volume: -1.0,
         };
         let c = domain(&mut cdt, &[], &[region(0.5, 7.0), region(1.5, -2.0)], true);
-        for (&t, &a) in c.tets.iter().zip(&c.attributes) {
+        for ((&t, &a), &r) in c.tets.iter().zip(&c.attributes).zip(&c.regions) {
+            assert_eq!(r, if a == 7.0 { 0 } else { 1 });
             let left = cdt
                 .dt
                 .mesh

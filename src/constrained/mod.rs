@@ -183,6 +183,12 @@ pub struct PlcStats {
     pub facet_secs: f64,
     /// Seconds for carving.
     pub carve_secs: f64,
+    /// Points added by quality refinement (`-q`, `-a`).
+    pub refine_points: usize,
+    /// Tets left over the quality bounds next to small input angles.
+    pub refine_left: usize,
+    /// Seconds for quality refinement.
+    pub refine_secs: f64,
     /// The facet insertion algorithm used.
     pub inserter: FacetInserter,
     /// Flip insertion's figures (`-F`).
@@ -193,7 +199,7 @@ pub struct PlcStats {
 
 /// Whether to trace restarts, Steiner points, cavity widening and flip fallbacks on
 /// stderr (`TETCDT_DEBUG=1`).
-fn debug() -> bool {
+pub(crate) fn debug() -> bool {
     std::env::var_os("TETCDT_DEBUG").is_some()
 }
 

@@ -226,6 +226,14 @@ impl Delaunay {
         x
     }
 
+    /// Makes the next point location start at tet `t` (if alive): a caller that knows a
+    /// tet near the next point saves the walk.
+    pub fn start_walks_at(&mut self, t: TetId) {
+        if self.mesh.is_alive(t) && !self.mesh.is_ghost(t) {
+            self.last = t;
+        }
+    }
+
     /// Locates point `p` by a visibility walk from the last tet created.
     pub fn locate(&mut self, p: &Point) -> Location {
         self.locate_within(p, usize::MAX)

@@ -9,6 +9,7 @@ pub mod hilbert;
 pub mod lifted;
 pub mod polygon;
 pub mod predicates;
+pub mod quality;
 
 pub use predicates::{insphere, insphere_sos, orient3d, Point, Sign, StaticFilter};
 

@@ -20,6 +20,7 @@
 //! [`Cdt::insert_polygon`] adds a polygon as a new facet, all or nothing (`polygon.rs`).
 
 mod polygon;
+mod refine;
 mod split;
 #[cfg(test)]
 mod tests;
@@ -37,6 +38,7 @@ use crate::plc::prepare::PreparedPlc;
 use crate::plc::Plc;
 
 pub use polygon::{PolygonError, PolygonInserted};
+pub use refine::{RefineParameters, RefineResult};
 
 /// Why [`Cdt::insert_vertex`] left a point out (the CDT is then as it was before the
 /// point's own insertion, with any splits made for it kept: they are valid).
@@ -114,12 +116,21 @@ impl Cdt {
         let elements = crate::precheck::check_elements(plc)?;
         crate::precheck::check_surface(plc, &elements)?;
         let c = crate::constrained::construct(plc, opts, &crate::progress::no_progress)?;
+        Ok(Cdt::of_construction(plc, opts, c))
+    }
+
+    /// The live CDT of a finished construction of `plc`.
+    pub(crate) fn of_construction(
+        plc: &Plc,
+        opts: &PlcOptions,
+        c: crate::constrained::Constructed,
+    ) -> Cdt {
         let built = *c.built;
         let mut tets = built.cdt;
         tets.subsegs = built.seg_markers;
         let next_pert = tets.dt.orig.iter().map(|&o| o + 1).max().unwrap_or(0);
         let next_pert = next_pert.max(plc.points.len() as u32);
-        Ok(Cdt {
+        Cdt {
             plc: plc.clone(),
             opts: opts.clone(),
             meshed: c.split.unwrap_or_else(|| c.base.clone()),
@@ -132,7 +143,7 @@ impl Cdt {
             warnings: c.warnings,
             next_pert,
             added: 0,
-        })
+        }
     }
 
     /// Warnings from building it.
@@ -169,6 +180,27 @@ impl Cdt {
     pub fn mesh(&self) -> Result<MeshOut, Error> {
         let mut stats = self.stats.clone();
         crate::carve::carve_copy(&self.plc, &self.meshed, &self.tets, &self.opts, &mut stats)
+    }
+
+    /// The mesh, carved, in output form, with the PLC as prepared for meshing (which
+    /// the certifier judges it against) and the figures: the end of the pipeline.
+    pub(crate) fn into_mesh(
+        self,
+        progress: crate::progress::Progress<'_>,
+    ) -> Result<(MeshOut, PreparedPlc, PlcStats, Vec<String>), Error> {
+        let mut stats = self.stats;
+        stats.steiner_points += self.added;
+        let subsegs = self.tets.subsegs.clone();
+        let built = crate::constrained::construction::Built::of(self.tets, subsegs);
+        let mesh = crate::carve::carve(
+            &self.plc,
+            &self.meshed,
+            built,
+            &self.opts,
+            &mut stats,
+            progress,
+        )?;
+        Ok((mesh, self.judged.1, stats, self.warnings))
     }
 
     /// Certifies the carved mesh as a CDT of the PLC ([`crate::check`]).
@@ -247,6 +279,12 @@ impl Cdt {
     fn split_bound(&self) -> usize {
         let (s, f) = self.num_constraints();
         4 * (s + f + self.num_vertices()) + 64
+    }
+
+    /// Sets the most Steiner points the CDT may have, those of its construction
+    /// included (`-S`).
+    pub fn set_steiner_budget(&mut self, n: usize) {
+        self.opts.max_steiner = n;
     }
 
     fn check_budget(&self) -> Result<(), InsertError> {

@@ -327,3 +327,42 @@ fn points_rounded_off_a_facet_split_it() {
     }
     assert!(off_plane > 0, "no point was rounded off the plane");
 }
+
+#[test]
+fn refinement_meets_its_bounds_and_stays_a_cdt() {
+    let plc = model("data/examples/box_with_hole.poly");
+    let mut cdt = Cdt::build(&plc, &Default::default()).unwrap();
+    let before = cdt.num_vertices();
+    let params = RefineParameters {
+        max_ratio: Some(1.3),
+        max_volume: Some(0.05),
+        ..Default::default()
+    };
+    let r = cdt.refine(&params);
+    assert_eq!(r.left, 0);
+    assert!(!r.budget_spent);
+    assert_eq!(cdt.num_vertices(), before + r.points);
+    cdt.certify().unwrap();
+    let mesh = cdt.mesh().unwrap();
+    for t in &mesh.tets {
+        let p = t.map(|v| mesh.points[v as usize]);
+        assert!(crate::geom::quality::radius_edge_ratio(&p) <= 1.3);
+        assert!(crate::geom::quality::volume(&p) <= 0.05);
+    }
+    // Nothing asked, nothing done.
+    let again = cdt.refine(&RefineParameters::default());
+    assert_eq!(again, RefineResult::default());
+}
+
+#[test]
+fn refinement_stops_at_the_steiner_budget() {
+    let plc = model("data/examples/cube.poly");
+    let mut cdt = Cdt::build(&plc, &Default::default()).unwrap();
+    cdt.set_steiner_budget(10);
+    let r = cdt.refine(&RefineParameters {
+        max_volume: Some(1e-4),
+        ..Default::default()
+    });
+    assert!(r.budget_spent && r.left > 0 && r.points <= 10);
+    cdt.certify().unwrap();
+}

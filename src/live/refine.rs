@@ -1,0 +1,403 @@
+//! Delaunay refinement of the live CDT (`-q`, `-a`): the tets of the domain that are too
+//! elongated, too flat or too large are split at their circumcentres, in place, until
+//! none is left or the ones left are next to small input angles.
+//!
+//! A bad tet's circumcentre is found by a walk from the tet that stops at subfaces:
+//! - inside the domain, where it encroaches upon no constraint, it is inserted (a walled
+//!   cavity and flips, as every free point);
+//! - where it lies in the diametral ball of a subsegment, or the equatorial ball of a
+//!   subface, of its cavity, that constraint is split instead (Shewchuk's rule: middles
+//!   of subsegments, or power-of-two shells around input vertices; circumcentres of
+//!   subfaces, or their subsegments when those encroach);
+//! - beyond a subface (outside the tet's side of it), that subface is split.
+//!
+//! The point a bad tet asks for must lie at least half the tet's shortest edge from every
+//! vertex of its cavity (never less than a fixed floor): a circumcentre always does, and a
+//! split point closer than that comes from a small input angle, where splitting would
+//! only make ever shorter edges; the tet is then left (counted). ARCHITECTURE.md gives
+//! why refinement ends.
+
+use super::{Cdt, InsertError};
+use crate::constrained::cdt::face_key;
+use crate::constrained::domain::NO_REGION;
+use crate::geom::encroach::{circumcenter as face_circumcenter, in_diametral_ball};
+use crate::geom::quality;
+use crate::geom::{norm, orient3d, sub, Point};
+use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
+use rustc_hash::FxHashSet;
+
+/// What refinement aims for.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RefineParameters {
+    /// The largest radius-edge ratio a tet may keep (`-q`).
+    pub max_ratio: Option<f64>,
+    /// The smallest dihedral angle a tet may keep, in degrees (`-q…/angle`).
+    pub min_dihedral: Option<f64>,
+    /// The largest volume a tet may keep (`-a<vol>`).
+    pub max_volume: Option<f64>,
+    /// Whether each region's volume bound from the PLC applies too (`-a`).
+    pub region_volumes: bool,
+}
+
+impl RefineParameters {
+    /// Whether any bound is set.
+    pub fn any(&self) -> bool {
+        self.max_ratio.is_some()
+            || self.min_dihedral.is_some_and(|a| a > 0.0)
+            || self.max_volume.is_some()
+            || self.region_volumes
+    }
+}
+
+/// What refinement did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct RefineResult {
+    /// Points added (circumcentres and constraint splits).
+    pub points: usize,
+    /// Bad tets left in the domain, each next to a vertex that a split would come
+    /// closer to than its insertion radius floor allows (small input angles).
+    pub left: usize,
+    /// Passes over the domain.
+    pub passes: usize,
+    /// Whether the Steiner point budget (`-S`) ran out first.
+    pub budget_spent: bool,
+}
+
+/// Where the walk from a tet toward a point ends.
+enum Walk {
+    /// In a tet (or on its boundary) reached without crossing a subface.
+    Inside(TetId),
+    /// At this subface, which the point lies beyond.
+    Wall([VertexId; 3]),
+    /// At the hull, through a face that is no subface (the convex hull is kept).
+    Hull,
+}
+
+/// A constraint a point encroaches upon.
+#[derive(Clone, Copy)]
+enum Encroached {
+    Subsegment(VertexId, VertexId),
+    Subface([VertexId; 3]),
+}
+
+impl Cdt {
+    /// Refines the CDT's domain to `params` in place (see the module docs); every tet
+    /// of the domain then meets the bounds, except the ones counted as left.
+    pub fn refine(&mut self, params: &RefineParameters) -> RefineResult {
+        let mut result = RefineResult::default();
+        if !params.any() {
+            return result;
+        }
+        let floor = self.insertion_floor(params);
+        let mut left: FxHashSet<[VertexId; 4]> = FxHashSet::default();
+        // Points the CDT refused once: a point is refused by the same CDT around it, so
+        // the tets asking for it again are left without trying.
+        let mut refused: FxHashSet<[u64; 3]> = FxHashSet::default();
+        loop {
+            result.passes += 1;
+            let bad = self.bad_tets(params, &left);
+            if bad.is_empty() {
+                break;
+            }
+            let mut changed = false;
+            for (_, key, t) in bad {
+                let mesh = &self.tets.dt.mesh;
+                // A tet an earlier split of this pass removed is judged again next pass.
+                if !mesh.is_alive(t) || sorted(mesh.verts(t)) != key {
+                    continue;
+                }
+                match self.split_bad_tet(t, floor, &mut refused) {
+                    Ok(Some(n)) => {
+                        result.points += n;
+                        changed = true;
+                    }
+                    Ok(None) => {
+                        left.insert(key);
+                    }
+                    Err(InsertError::Budget(_)) => {
+                        result.budget_spent = true;
+                        result.left = self.bad_tets(params, &FxHashSet::default()).len();
+                        return result;
+                    }
+                    // The point could not go in here (the CDT is as valid as before):
+                    // the tet is left.
+                    Err(e) => {
+                        if crate::constrained::debug() {
+                            eprintln!("refine: tet {key:?} left: {e}");
+                        }
+                        left.insert(key);
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        result.left = self.bad_tets(params, &FxHashSet::default()).len();
+        result
+    }
+
+    /// The bad tets of the domain not in `left`, worst first: (how far over its bound,
+    /// sorted vertices, tet).
+    fn bad_tets(
+        &mut self,
+        params: &RefineParameters,
+        left: &FxHashSet<[VertexId; 4]>,
+    ) -> Vec<(f64, [VertexId; 4], TetId)> {
+        let dom = crate::constrained::domain::domain(
+            &mut self.tets,
+            &self.plc.holes,
+            &self.plc.regions,
+            self.opts.keep_hull,
+        );
+        let mut bad = Vec::new();
+        for (&t, &r) in dom.tets.iter().zip(&dom.regions) {
+            let v = self.tets.dt.mesh.verts(t);
+            let p = self.corners(t);
+            let region_volume = (params.region_volumes && r != NO_REGION)
+                .then(|| self.plc.regions[r as usize].max_volume)
+                .filter(|&m| m > 0.0);
+            let volume_bound = match (params.max_volume, region_volume) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+            // How far over its bounds the tet is (1 and below: within them).
+            let mut over = 0.0f64;
+            if let Some(b) = params.max_ratio {
+                over = over.max(quality::radius_edge_ratio(&p) / b);
+            }
+            if let Some(vb) = volume_bound {
+                over = over.max(quality::volume(&p) / vb);
+            }
+            if let Some(a) = params.min_dihedral.filter(|&a| a > 0.0) {
+                over = over.max(a / quality::dihedral_range(&p).0.max(1e-3));
+            }
+            if over > 1.0 {
+                let key = sorted(v);
+                if !left.contains(&key) {
+                    bad.push((over, key, t));
+                }
+            }
+        }
+        bad.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        bad
+    }
+
+    /// The distance below which no refinement point comes to a vertex: a quarter of the
+    /// shortest edge of the domain's tets, or of the edge of a regular tet of the
+    /// smallest volume bound if that is shorter. Halving is the most the insertion radii
+    /// shrink along Shewchuk's chain away from small angles, and a vertex can lie nearer
+    /// a facet than any of its edges are long: the second half. Only its being positive
+    /// matters for termination (the packing bound of ARCHITECTURE.md).
+    fn insertion_floor(&mut self, params: &RefineParameters) -> f64 {
+        let dom = crate::constrained::domain::domain(
+            &mut self.tets,
+            &self.plc.holes,
+            &self.plc.regions,
+            self.opts.keep_hull,
+        );
+        let shortest = dom
+            .tets
+            .iter()
+            .map(|&t| quality::shortest_edge(&self.corners(t)))
+            .fold(f64::INFINITY, f64::min);
+        let regions = self.plc.regions.iter().map(|r| r.max_volume);
+        let smallest_volume = params
+            .max_volume
+            .into_iter()
+            .chain(regions.filter(|_| params.region_volumes))
+            .filter(|&v| v > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        // A regular tet of edge a has volume a³ / (6√2).
+        let edge_of_volume = (6.0 * 2f64.sqrt() * smallest_volume).cbrt();
+        0.25 * shortest.min(edge_of_volume)
+    }
+
+    /// Splits bad tet `t` (see the module docs): the points added, or `None` if the tet
+    /// is left.
+    fn split_bad_tet(
+        &mut self,
+        t: TetId,
+        floor: f64,
+        refused: &mut FxHashSet<[u64; 3]>,
+    ) -> Result<Option<usize>, InsertError> {
+        let p = self.corners(t);
+        let Some(c) = quality::circumcenter(&p) else {
+            return Ok(None);
+        };
+        let shortest = quality::shortest_edge(&p);
+        // Half the shortest edge: a tet's circumradius is at least that, so a
+        // circumcentre that encroaches upon nothing always goes in; a split point closer
+        // to a vertex than that comes from a small input angle (Shewchuk's chain of
+        // insertion radii shrinks by at most this factor elsewhere).
+        let dbg = crate::constrained::debug();
+        let need = floor.max(0.5 * shortest);
+        let target = match self.walk_toward(t, &c) {
+            Walk::Hull => return Ok(None),
+            Walk::Wall(f) => Some(Encroached::Subface(f)),
+            Walk::Inside(at) => {
+                self.tets.dt.start_walks_at(at);
+                self.encroached_by(&c)
+            }
+        };
+        let Some(e) = target else {
+            let radius = norm(&sub(&c, &p[0]));
+            if radius < need {
+                if dbg {
+                    eprintln!("refine: circumradius {radius} under {need}");
+                }
+                return Ok(None);
+            }
+            let before = self.added;
+            self.insert_vertex_id(c)?;
+            return Ok(Some(self.added - before));
+        };
+        let m = match e {
+            Encroached::Subsegment(a, b) => self.edge_split_point(a, b),
+            Encroached::Subface(f) => {
+                let [a, b, c] = f.map(|x| self.tets.dt.points[x as usize]);
+                face_circumcenter(&a, &b, &c)
+            }
+        };
+        if refused.contains(&m.map(f64::to_bits)) {
+            return Ok(None);
+        }
+        if self.insertion_radius(&m) < need {
+            if dbg {
+                eprintln!("refine: split point of an encroached constraint too close");
+            }
+            return Ok(None);
+        }
+        let n = match e {
+            Encroached::Subsegment(a, b) => self.split_subsegment(a, b),
+            Encroached::Subface(f) => self.split_subface(f),
+        };
+        if dbg {
+            if let Err(err) = &n {
+                let kind = match e {
+                    Encroached::Subsegment(..) => "subsegment",
+                    Encroached::Subface(..) => "subface",
+                };
+                eprintln!("refine: split of a {kind} failed: {err}");
+            }
+        }
+        if matches!(n, Err(InsertError::Refused(_))) {
+            refused.insert(m.map(f64::to_bits));
+        }
+        let n = n?;
+        Ok(Some(n))
+    }
+
+    /// The corners of tet `t`.
+    fn corners(&self, t: TetId) -> [Point; 4] {
+        self.tets
+            .dt
+            .mesh
+            .verts(t)
+            .map(|x| self.tets.dt.points[x as usize])
+    }
+
+    /// Walks from tet `t` toward `c` through faces that are no subfaces.
+    fn walk_toward(&self, mut t: TetId, c: &Point) -> Walk {
+        let mesh = &self.tets.dt.mesh;
+        let pt = |x: VertexId| &self.tets.dt.points[x as usize];
+        let mut from = 4usize;
+        // In a CDT a visibility walk can cycle; past a step per tet it is given up, and
+        // the point is treated as beyond the tet's hull side (the tet is left).
+        let bound = mesh.num_slots() + 16;
+        for step in 0..bound {
+            let mut next = None;
+            for r in 0..4 {
+                let i = (step + r) & 3;
+                if i == from {
+                    continue;
+                }
+                let f = mesh.face_verts(t, i);
+                if orient3d(pt(f[0]), pt(f[1]), pt(f[2]), c) < 0.0 {
+                    next = Some((i, f));
+                    break;
+                }
+            }
+            let Some((i, f)) = next else {
+                return Walk::Inside(t);
+            };
+            if self.tets.subfaces.contains_key(&face_key(f)) {
+                return Walk::Wall(f);
+            }
+            let n = mesh.adj(FaceRef::new(t, i));
+            if mesh.is_ghost(n.tet()) {
+                return Walk::Hull;
+            }
+            t = n.tet();
+            from = n.face();
+        }
+        Walk::Hull
+    }
+
+    /// The constraint of point `c`'s walled cavity that `c` encroaches upon, if any: a
+    /// subsegment first (the one with the lowest key), then a subface.
+    fn encroached_by(&mut self, c: &Point) -> Option<Encroached> {
+        let pert = self.next_pert;
+        let subfaces = &self.tets.subfaces;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            subfaces.contains_key(&face_key(FACE_VERTS[f].map(|k| v[k])))
+        };
+        let conflict = self.tets.dt.walled_conflict(*c, pert, blocked).ok()?;
+        let pt = |x: VertexId| &self.tets.dt.points[x as usize];
+        let mut seg: Option<(VertexId, VertexId)> = None;
+        let mut face: Option<[VertexId; 3]> = None;
+        for &t in &conflict {
+            let v = self.tets.dt.mesh.verts(t);
+            for &(i, j) in &EDGE_VERTS {
+                let e = crate::constrained::cdt::edge_key(v[i], v[j]);
+                if e.1 == GHOST || !self.tets.subsegs.contains_key(&e) {
+                    continue;
+                }
+                if seg.is_none_or(|s| e < s) && in_diametral_ball(pt(e.0), pt(e.1), c) {
+                    seg = Some(e);
+                }
+            }
+            for fv in FACE_VERTS {
+                let k = face_key(fv.map(|i| v[i]));
+                if k.contains(&GHOST) || !self.tets.subfaces.contains_key(&k) {
+                    continue;
+                }
+                if face.is_none_or(|g| k < g)
+                    && crate::geom::encroach::in_equatorial_ball(pt(k[0]), pt(k[1]), pt(k[2]), c)
+                {
+                    face = Some(k);
+                }
+            }
+        }
+        seg.map(|(a, b)| Encroached::Subsegment(a, b))
+            .or(face.map(Encroached::Subface))
+    }
+
+    /// The distance from `m` to the nearest vertex of its walled cavity: the length of
+    /// the shortest edge its insertion would make.
+    fn insertion_radius(&mut self, m: &Point) -> f64 {
+        let pert = self.next_pert;
+        let subfaces = &self.tets.subfaces;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            subfaces.contains_key(&face_key(FACE_VERTS[f].map(|k| v[k])))
+        };
+        let Ok(conflict) = self.tets.dt.walled_conflict(*m, pert, blocked) else {
+            return 0.0;
+        };
+        let mut r = f64::INFINITY;
+        for &t in &conflict {
+            for x in self.tets.dt.mesh.verts(t) {
+                if x != GHOST {
+                    r = r.min(norm(&sub(&self.tets.dt.points[x as usize], m)));
+                }
+            }
+        }
+        r
+    }
+}
+
+/// The vertices of a tet, sorted: its key across passes.
+fn sorted(mut v: [VertexId; 4]) -> [VertexId; 4] {
+    v.sort_unstable();
+    v
+}

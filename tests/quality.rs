@@ -1,0 +1,264 @@
+//! Quality refinement (`-q`, `-a`): every bound is met by every tet but the ones counted
+//! as left next to small input angles, per-region volume bounds hold with `-A`, and
+//! refinement ends on PLCs with small input angles. Every run here exits 0, which means
+//! its mesh passed the certifier (a constrained Delaunay tetrahedralization of the PLC).
+
+use assert_cmd::Command;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+use tetcdt::geom::quality;
+
+/// A refined mesh as read back from its files, with the run's figures.
+struct Refined {
+    points: Vec<[f64; 3]>,
+    tets: Vec<[usize; 4]>,
+    attributes: Vec<f64>,
+    /// `refine_left` from `--stats-json`.
+    left: usize,
+}
+
+impl Refined {
+    fn corners(&self, t: &[usize; 4]) -> [[f64; 3]; 4] {
+        t.map(|v| self.points[v])
+    }
+
+    /// Tets over `ratio`.
+    fn over_ratio(&self, ratio: f64) -> usize {
+        let over = |t: &&[usize; 4]| quality::radius_edge_ratio(&self.corners(t)) > ratio;
+        self.tets.iter().filter(over).count()
+    }
+
+    /// Tets with a dihedral angle under `angle` degrees.
+    fn under_angle(&self, angle: f64) -> usize {
+        let under = |t: &&[usize; 4]| quality::dihedral_range(&self.corners(t)).0 < angle;
+        self.tets.iter().filter(under).count()
+    }
+
+    /// The largest tet volume.
+    fn max_volume(&self) -> f64 {
+        let vol = |t: &[usize; 4]| quality::volume(&self.corners(t));
+        self.tets.iter().map(vol).fold(0.0, f64::max)
+    }
+}
+
+fn numbers(path: &Path) -> Vec<Vec<f64>> {
+    fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split('#').next().unwrap())
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
+/// Meshes `model` with `switches` in a fresh directory; the run must exit 0.
+fn refine(model: &Path, switches: &str) -> Refined {
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = dir.path().join("out");
+    let stats = dir.path().join("stats.json");
+    Command::cargo_bin("tetcdt")
+        .unwrap()
+        .timeout(Duration::from_secs(120))
+        .args([switches, "-Q", "-o"])
+        .arg(&prefix)
+        .arg("--stats-json")
+        .arg(&stats)
+        .arg(model)
+        .assert()
+        .success();
+    let node = numbers(&prefix.with_extension("node"));
+    let first = node[1][0] as usize;
+    let points = node[1..].iter().map(|r| [r[1], r[2], r[3]]).collect();
+    let ele = numbers(&prefix.with_extension("ele"));
+    let tets = ele[1..]
+        .iter()
+        .map(|r| std::array::from_fn(|k| r[k + 1] as usize - first))
+        .collect();
+    let attributes = ele[1..].iter().filter_map(|r| r.get(5).copied()).collect();
+    let json = fs::read_to_string(&stats).unwrap();
+    let left = json
+        .split("\"refine_left\": ")
+        .nth(1)
+        .and_then(|s| s.split([',', '}']).next())
+        .and_then(|s| s.trim().parse().ok())
+        .expect("refine_left in the figures");
+    Refined {
+        points,
+        tets,
+        attributes,
+        left,
+    }
+}
+
+fn example(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(name)
+}
+
+/// Writes a `.poly` of `points` and polygon facets into `dir`.
+fn poly(dir: &Path, name: &str, points: &[[f64; 3]], facets: &[&[usize]]) -> PathBuf {
+    let mut s = format!("{} 3 0 0\n", points.len());
+    for (i, p) in points.iter().enumerate() {
+        s += &format!("{i} {} {} {}\n", p[0], p[1], p[2]);
+    }
+    s += &format!("{} 0\n", facets.len());
+    for f in facets {
+        let ids: Vec<String> = f.iter().map(|v| v.to_string()).collect();
+        s += &format!("1\n{} {}\n", f.len(), ids.join(" "));
+    }
+    s += "0\n0\n";
+    let path = dir.join(name);
+    fs::write(&path, s).unwrap();
+    path
+}
+
+#[test]
+fn the_radius_edge_bound_is_met() {
+    for (model, ratio) in [
+        ("examples/box_with_hole.poly", 1.414),
+        ("examples/box_with_hole.poly", 1.05),
+        ("plc/gridbox_3.smesh", 1.414),
+    ] {
+        let m = refine(&example(model), &format!("-pq{ratio}"));
+        let over = m.over_ratio(ratio);
+        assert!(
+            over <= m.left,
+            "{model}: {over} tets over {ratio}, {} left",
+            m.left
+        );
+        assert_eq!(m.left, 0, "{model}: no small input angle, nothing is left");
+        // It did refine: the unrefined meshes have tets over these bounds.
+        let plain = refine(&example(model), "-p");
+        assert!(plain.over_ratio(ratio) > 0 && m.points.len() > plain.points.len());
+    }
+}
+
+#[test]
+fn the_dihedral_bound_is_met() {
+    let m = refine(&example("examples/box_with_hole.poly"), "-pq1.5/35");
+    assert_eq!(m.left, 0);
+    assert_eq!(m.over_ratio(1.5) + m.under_angle(35.0), 0);
+    let plain = refine(&example("examples/box_with_hole.poly"), "-pq1.5");
+    assert!(
+        plain.under_angle(35.0) > 0,
+        "the angle bound is what refines further"
+    );
+}
+
+#[test]
+fn the_volume_bound_is_met() {
+    for bound in [0.05, 0.002] {
+        let m = refine(
+            &example("examples/box_with_hole.poly"),
+            &format!("-pa{bound}"),
+        );
+        assert!(m.max_volume() <= bound, "{} over {bound}", m.max_volume());
+        let total: f64 = m.tets.iter().map(|t| quality::volume(&m.corners(t))).sum();
+        assert!(total > 0.0);
+    }
+}
+
+#[test]
+fn regions_keep_their_own_volume_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = fs::read_to_string(example("plc/box_internal_facet.poly")).unwrap();
+    // Region 10 (x < 1) at most 0.01, region 20 (x > 1) at most 0.001.
+    let text = text
+        .replace("0 0.5 0.5 0.5 10 -1", "0 0.5 0.5 0.5 10 0.01")
+        .replace("1 1.5 0.5 0.5 20 -1", "1 1.5 0.5 0.5 20 0.001");
+    let model = dir.path().join("regions.poly");
+    fs::write(&model, text).unwrap();
+    let m = refine(&model, "-paA");
+    assert_eq!(m.attributes.len(), m.tets.len());
+    let mut seen = [false; 2];
+    for (t, &a) in m.tets.iter().zip(&m.attributes) {
+        let bound = if a == 10.0 { 0.01 } else { 0.001 };
+        seen[(a == 20.0) as usize] = true;
+        let v = quality::volume(&m.corners(t));
+        assert!(v <= bound, "a tet of region {a} has volume {v}");
+    }
+    assert_eq!(seen, [true, true]);
+    // A global bound below both wins everywhere.
+    let m = refine(&model, "-pa0.0005aA");
+    assert!(m.max_volume() <= 0.0005);
+}
+
+#[test]
+fn refinement_ends_at_small_input_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    // An acute cone: a square pyramid 40 times taller than wide (an apex angle near 1.4
+    // degrees).
+    let cone = poly(
+        dir.path(),
+        "cone.poly",
+        &[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 0.5, 40.0],
+        ],
+        &[
+            &[0, 3, 2, 1],
+            &[0, 1, 4],
+            &[1, 2, 4],
+            &[2, 3, 4],
+            &[3, 0, 4],
+        ],
+    );
+    // A thin slit: a wedge whose two large faces meet at an edge at 2 degrees.
+    let t = 2f64.to_radians().tan();
+    let slit = poly(
+        dir.path(),
+        "slit.poly",
+        &[
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [4.0, 1.0, 0.0],
+            [4.0, 0.0, 4.0 * t],
+            [4.0, 1.0, 4.0 * t],
+        ],
+        &[
+            &[0, 2, 3, 1],
+            &[0, 1, 5, 4],
+            &[2, 4, 5, 3],
+            &[0, 4, 2],
+            &[1, 3, 5],
+        ],
+    );
+    // A needle: a triangular prism 100 times longer than its side.
+    let needle = poly(
+        dir.path(),
+        "needle.poly",
+        &[
+            [0.0, 0.0, 0.0],
+            [0.1, 0.0, 0.0],
+            [0.05, 0.08, 0.0],
+            [0.0, 0.0, 10.0],
+            [0.1, 0.0, 10.0],
+            [0.05, 0.08, 10.0],
+        ],
+        &[
+            &[0, 2, 1],
+            &[3, 4, 5],
+            &[0, 1, 4, 3],
+            &[1, 2, 5, 4],
+            &[2, 0, 3, 5],
+        ],
+    );
+    for model in [&cone, &slit, &needle] {
+        for switches in ["-pq1.414", "-pq1.2/10", "-pq1.414a0.001"] {
+            let m = refine(model, switches);
+            let over = m.over_ratio(1.414);
+            assert!(
+                over <= m.left,
+                "{}: {over} tets over the bound, {} counted",
+                model.display(),
+                m.left
+            );
+        }
+    }
+}
