@@ -108,6 +108,10 @@ pub struct Cdt {
     next_pert: u32,
     /// Steiner points added by insertions.
     added: usize,
+    /// While refining: the split points the CDT refused, which are not tried again
+    /// (many bad tets lead to the same split, through the constraints they encroach
+    /// upon, and the CDT around it rarely changes in between).
+    refused_splits: Option<rustc_hash::FxHashSet<[u64; 3]>>,
 }
 
 impl Cdt {
@@ -143,6 +147,7 @@ impl Cdt {
             warnings: c.warnings,
             next_pert,
             added: 0,
+            refused_splits: None,
         }
     }
 

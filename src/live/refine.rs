@@ -63,6 +63,17 @@ pub struct RefineResult {
     pub budget_spent: bool,
 }
 
+/// A bad tet of the domain.
+struct Bad {
+    /// How far over its bounds it is (above 1).
+    over: f64,
+    /// Its sorted vertices: its key across passes.
+    key: [VertexId; 4],
+    tet: TetId,
+    /// The volume bound of its region, if any.
+    volume_bound: Option<f64>,
+}
+
 /// Where the walk from a tet toward a point ends.
 enum Walk {
     /// In a tet (or on its boundary) reached without crossing a subface.
@@ -84,35 +95,44 @@ impl Cdt {
     /// Refines the CDT's domain to `params` in place (see the module docs); every tet
     /// of the domain then meets the bounds, except the ones counted as left.
     pub fn refine(&mut self, params: &RefineParameters) -> RefineResult {
-        let mut result = RefineResult::default();
         if !params.any() {
-            return result;
+            return RefineResult::default();
         }
         let floor = self.insertion_floor(params);
+        self.refused_splits = Some(FxHashSet::default());
+        let result = self.refine_passes(params, floor);
+        self.refused_splits = None;
+        result
+    }
+
+    /// The passes of [`Cdt::refine`], with insertion floor `floor`.
+    fn refine_passes(&mut self, params: &RefineParameters, floor: f64) -> RefineResult {
+        let mut result = RefineResult::default();
         let mut left: FxHashSet<[VertexId; 4]> = FxHashSet::default();
-        // Points the CDT refused once: a point is refused by the same CDT around it, so
-        // the tets asking for it again are left without trying.
-        let mut refused: FxHashSet<[u64; 3]> = FxHashSet::default();
         loop {
             result.passes += 1;
-            let bad = self.bad_tets(params, &left);
-            if bad.is_empty() {
-                break;
-            }
+            let mut listed = self.bad_tets(params, &left).into_iter();
+            // The bad tets around a new interior vertex are split next, before the pass
+            // goes on down its list: most of a pass's tets are gone by the time the list
+            // reaches them, and the tets that replaced them are these.
+            let mut around: Vec<Bad> = Vec::new();
             let mut changed = false;
-            for (_, key, t) in bad {
+            while let Some(b) = around.pop().or_else(|| listed.next()) {
                 let mesh = &self.tets.dt.mesh;
-                // A tet an earlier split of this pass removed is judged again next pass.
-                if !mesh.is_alive(t) || sorted(mesh.verts(t)) != key {
+                // A tet an earlier split removed is judged again next pass.
+                if !mesh.is_alive(b.tet) || sorted(mesh.verts(b.tet)) != b.key {
                     continue;
                 }
-                match self.split_bad_tet(t, floor, &mut refused) {
-                    Ok(Some(n)) => {
+                match self.split_bad_tet(b.tet, floor) {
+                    Ok(Some((n, vertex))) => {
                         result.points += n;
                         changed = true;
+                        if let Some(v) = vertex {
+                            around.extend(self.bad_around(v, params, b.volume_bound, &left));
+                        }
                     }
                     Ok(None) => {
-                        left.insert(key);
+                        left.insert(b.key);
                     }
                     Err(InsertError::Budget(_)) => {
                         result.budget_spent = true;
@@ -123,11 +143,19 @@ impl Cdt {
                     // the tet is left.
                     Err(e) => {
                         if crate::constrained::debug() {
-                            eprintln!("refine: tet {key:?} left: {e}");
+                            eprintln!("refine: tet {:?} left: {e}", b.key);
                         }
-                        left.insert(key);
+                        left.insert(b.key);
                     }
                 }
+            }
+            if crate::constrained::debug() {
+                eprintln!(
+                    "refine: pass {} points {} left {}",
+                    result.passes,
+                    result.points,
+                    left.len()
+                );
             }
             if !changed {
                 break;
@@ -137,13 +165,8 @@ impl Cdt {
         result
     }
 
-    /// The bad tets of the domain not in `left`, worst first: (how far over its bound,
-    /// sorted vertices, tet).
-    fn bad_tets(
-        &mut self,
-        params: &RefineParameters,
-        left: &FxHashSet<[VertexId; 4]>,
-    ) -> Vec<(f64, [VertexId; 4], TetId)> {
+    /// The bad tets of the domain not in `left`, worst first.
+    fn bad_tets(&mut self, params: &RefineParameters, left: &FxHashSet<[VertexId; 4]>) -> Vec<Bad> {
         let dom = crate::constrained::domain::domain(
             &mut self.tets,
             &self.plc.holes,
@@ -152,8 +175,6 @@ impl Cdt {
         );
         let mut bad = Vec::new();
         for (&t, &r) in dom.tets.iter().zip(&dom.regions) {
-            let v = self.tets.dt.mesh.verts(t);
-            let p = self.corners(t);
             let region_volume = (params.region_volumes && r != NO_REGION)
                 .then(|| self.plc.regions[r as usize].max_volume)
                 .filter(|&m| m > 0.0);
@@ -161,26 +182,67 @@ impl Cdt {
                 (Some(a), Some(b)) => Some(a.min(b)),
                 (a, b) => a.or(b),
             };
-            // How far over its bounds the tet is (1 and below: within them).
-            let mut over = 0.0f64;
-            if let Some(b) = params.max_ratio {
-                over = over.max(quality::radius_edge_ratio(&p) / b);
-            }
-            if let Some(vb) = volume_bound {
-                over = over.max(quality::volume(&p) / vb);
-            }
-            if let Some(a) = params.min_dihedral.filter(|&a| a > 0.0) {
-                over = over.max(a / quality::dihedral_range(&p).0.max(1e-3));
-            }
-            if over > 1.0 {
-                let key = sorted(v);
-                if !left.contains(&key) {
-                    bad.push((over, key, t));
-                }
-            }
+            bad.extend(self.judge(t, params, volume_bound, left));
         }
-        bad.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        bad.sort_by(|a, b| b.over.total_cmp(&a.over).then(a.key.cmp(&b.key)));
         bad
+    }
+
+    /// Tet `t` if it is bad (and not in `left`), with volume bound `volume_bound`.
+    fn judge(
+        &self,
+        t: TetId,
+        params: &RefineParameters,
+        volume_bound: Option<f64>,
+        left: &FxHashSet<[VertexId; 4]>,
+    ) -> Option<Bad> {
+        let p = self.corners(t);
+        // How far over its bounds the tet is (1 and below: within them).
+        let mut over = 0.0f64;
+        if let Some(b) = params.max_ratio {
+            over = over.max(quality::radius_edge_ratio(&p) / b);
+        }
+        if let Some(vb) = volume_bound {
+            over = over.max(quality::volume(&p) / vb);
+        }
+        if let Some(a) = params.min_dihedral.filter(|&a| a > 0.0) {
+            over = over.max(a / quality::dihedral_range(&p).0.max(1e-3));
+        }
+        let key = sorted(self.tets.dt.mesh.verts(t));
+        (over > 1.0 && !left.contains(&key)).then_some(Bad {
+            over,
+            key,
+            tet: t,
+            volume_bound,
+        })
+    }
+
+    /// The bad tets around vertex `v`, which went into a tet of the domain with volume
+    /// bound `volume_bound`: none if a face around `v` is a subface (then its star
+    /// may reach outside the domain or into another region), else its whole star, which
+    /// lies in that tet's region (no subface separates its tets).
+    fn bad_around(
+        &mut self,
+        v: VertexId,
+        params: &RefineParameters,
+        volume_bound: Option<f64>,
+        left: &FxHashSet<[VertexId; 4]>,
+    ) -> Vec<Bad> {
+        let mut star = Vec::new();
+        self.tets.dt.star(v, &mut star);
+        let on_constraint = star.iter().any(|&t| {
+            let w = self.tets.dt.mesh.verts(t);
+            FACE_VERTS.iter().any(|fv| {
+                let f = fv.map(|k| w[k]);
+                f.contains(&v) && self.tets.subfaces.contains_key(&face_key(f))
+            })
+        });
+        if on_constraint || star.iter().any(|&t| self.tets.is_ghost(t)) {
+            return Vec::new();
+        }
+        star.iter()
+            .filter_map(|&t| self.judge(t, params, volume_bound, left))
+            .collect()
     }
 
     /// The distance below which no refinement point comes to a vertex: a quarter of the
@@ -213,14 +275,13 @@ impl Cdt {
         0.25 * shortest.min(edge_of_volume)
     }
 
-    /// Splits bad tet `t` (see the module docs): the points added, or `None` if the tet
-    /// is left.
+    /// Splits bad tet `t` (see the module docs): the points added, with the vertex of
+    /// its circumcentre if that went in itself; `None` if the tet is left.
     fn split_bad_tet(
         &mut self,
         t: TetId,
         floor: f64,
-        refused: &mut FxHashSet<[u64; 3]>,
-    ) -> Result<Option<usize>, InsertError> {
+    ) -> Result<Option<(usize, Option<VertexId>)>, InsertError> {
         let p = self.corners(t);
         let Some(c) = quality::circumcenter(&p) else {
             return Ok(None);
@@ -230,11 +291,10 @@ impl Cdt {
         // circumcentre that encroaches upon nothing always goes in; a split point closer
         // to a vertex than that comes from a small input angle (Shewchuk's chain of
         // insertion radii shrinks by at most this factor elsewhere).
-        let dbg = crate::constrained::debug();
         let need = floor.max(0.5 * shortest);
         let target = match self.walk_toward(t, &c) {
             Walk::Hull => return Ok(None),
-            Walk::Wall(f) => Some(Encroached::Subface(f)),
+            Walk::Wall(f) => Some(Encroached::Subface(face_key(f))),
             Walk::Inside(at) => {
                 self.tets.dt.start_walks_at(at);
                 self.encroached_by(&c)
@@ -243,14 +303,11 @@ impl Cdt {
         let Some(e) = target else {
             let radius = norm(&sub(&c, &p[0]));
             if radius < need {
-                if dbg {
-                    eprintln!("refine: circumradius {radius} under {need}");
-                }
                 return Ok(None);
             }
             let before = self.added;
-            self.insert_vertex_id(c)?;
-            return Ok(Some(self.added - before));
+            let (v, _, _) = self.insert_vertex_id(c)?;
+            return Ok(Some((self.added - before, Some(v))));
         };
         let m = match e {
             Encroached::Subsegment(a, b) => self.edge_split_point(a, b),
@@ -259,33 +316,14 @@ impl Cdt {
                 face_circumcenter(&a, &b, &c)
             }
         };
-        if refused.contains(&m.map(f64::to_bits)) {
-            return Ok(None);
-        }
         if self.insertion_radius(&m) < need {
-            if dbg {
-                eprintln!("refine: split point of an encroached constraint too close");
-            }
             return Ok(None);
         }
         let n = match e {
-            Encroached::Subsegment(a, b) => self.split_subsegment(a, b),
-            Encroached::Subface(f) => self.split_subface(f),
+            Encroached::Subsegment(a, b) => self.split_subsegment(a, b)?,
+            Encroached::Subface(f) => self.split_subface(f)?,
         };
-        if dbg {
-            if let Err(err) = &n {
-                let kind = match e {
-                    Encroached::Subsegment(..) => "subsegment",
-                    Encroached::Subface(..) => "subface",
-                };
-                eprintln!("refine: split of a {kind} failed: {err}");
-            }
-        }
-        if matches!(n, Err(InsertError::Refused(_))) {
-            refused.insert(m.map(f64::to_bits));
-        }
-        let n = n?;
-        Ok(Some(n))
+        Ok(Some((n, None)))
     }
 
     /// The corners of tet `t`.

@@ -177,10 +177,17 @@ impl Cdt {
                     Target::Face(..) => return Err(InsertError::Refused(m)),
                 };
             }
+            if self
+                .refused_splits
+                .as_ref()
+                .is_some_and(|r| r.contains(&m.map(f64::to_bits)))
+            {
+                return Err(InsertError::Refused(m));
+            }
             let in_way = match top {
-                Target::Edge(a, b, _) => self.split_edge(a, b, m)?,
+                Target::Edge(a, b, _) => self.remember_refusal(m, |c| c.split_edge(a, b, m))?,
                 Target::Face(f, _) => match self.face_split(f, m) {
-                    FaceSplit::At => self.split_face(f, m)?,
+                    FaceSplit::At => self.remember_refusal(m, |c| c.split_face(f, m))?,
                     FaceSplit::Edge(a, b) => {
                         stack.pop();
                         stack.push(Target::Edge(a, b, None));
@@ -200,6 +207,20 @@ impl Cdt {
             made += 1;
         }
         Ok(made)
+    }
+
+    /// Runs split `f` at `m`, and remembers `m` if the CDT refuses it while refusals
+    /// are remembered ([`Cdt::refused_splits`]).
+    fn remember_refusal<T>(
+        &mut self,
+        m: Point,
+        f: impl FnOnce(&mut Self) -> Result<T, InsertError>,
+    ) -> Result<T, InsertError> {
+        let r = f(self);
+        if let (Err(InsertError::Refused(_)), Some(set)) = (&r, &mut self.refused_splits) {
+            set.insert(m.map(f64::to_bits));
+        }
+        r
     }
 
     /// The point a target is split at, or `None` if it is no longer in the CDT.
