@@ -192,6 +192,21 @@ impl Cdt {
         lost
     }
 
+    /// The tets whose circumspheres hold point `p` (perturbation index `pert`) and that
+    /// are reached from the tet holding it without crossing a subface; empty if `p` is
+    /// a vertex.
+    pub fn walled_conflict(
+        &mut self,
+        p: crate::geom::Point,
+        pert: u32,
+    ) -> Result<Vec<TetId>, crate::error::MeshError> {
+        let subfaces = &self.subfaces;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            subfaces.contains_key(&face_key(FACE_VERTS[f].map(|k| v[k])))
+        };
+        self.dt.walled_conflict(p, pert, blocked)
+    }
+
     /// Number of live real tets.
     pub fn num_tets(&self) -> usize {
         self.dt.mesh.real_tets().count()

@@ -20,10 +20,10 @@
 use super::{Cdt, InsertError};
 use crate::constrained::cdt::face_key;
 use crate::constrained::domain::NO_REGION;
-use crate::geom::encroach::{circumcenter as face_circumcenter, in_diametral_ball};
+use crate::geom::encroach::circumcenter as face_circumcenter;
 use crate::geom::quality;
 use crate::geom::{norm, orient3d, sub, Point};
-use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS, GHOST};
 use rustc_hash::FxHashSet;
 
 /// What refinement aims for.
@@ -376,37 +376,7 @@ impl Cdt {
     /// subsegment first (the one with the lowest key), then a subface.
     fn encroached_by(&mut self, c: &Point) -> Option<Encroached> {
         let pert = self.next_pert;
-        let subfaces = &self.tets.subfaces;
-        let blocked = |v: [VertexId; 4], f: usize| {
-            subfaces.contains_key(&face_key(FACE_VERTS[f].map(|k| v[k])))
-        };
-        let conflict = self.tets.dt.walled_conflict(*c, pert, blocked).ok()?;
-        let pt = |x: VertexId| &self.tets.dt.points[x as usize];
-        let mut seg: Option<(VertexId, VertexId)> = None;
-        let mut face: Option<[VertexId; 3]> = None;
-        for &t in &conflict {
-            let v = self.tets.dt.mesh.verts(t);
-            for &(i, j) in &EDGE_VERTS {
-                let e = crate::constrained::cdt::edge_key(v[i], v[j]);
-                if e.1 == GHOST || !self.tets.subsegs.contains_key(&e) {
-                    continue;
-                }
-                if seg.is_none_or(|s| e < s) && in_diametral_ball(pt(e.0), pt(e.1), c) {
-                    seg = Some(e);
-                }
-            }
-            for fv in FACE_VERTS {
-                let k = face_key(fv.map(|i| v[i]));
-                if k.contains(&GHOST) || !self.tets.subfaces.contains_key(&k) {
-                    continue;
-                }
-                if face.is_none_or(|g| k < g)
-                    && crate::geom::encroach::in_equatorial_ball(pt(k[0]), pt(k[1]), pt(k[2]), c)
-                {
-                    face = Some(k);
-                }
-            }
-        }
+        let (seg, face) = super::split::encroached_constraints(&mut self.tets, c, pert, None, true);
         seg.map(|(a, b)| Encroached::Subsegment(a, b))
             .or(face.map(Encroached::Subface))
     }
@@ -415,11 +385,7 @@ impl Cdt {
     /// the shortest edge its insertion would make.
     fn insertion_radius(&mut self, m: &Point) -> f64 {
         let pert = self.next_pert;
-        let subfaces = &self.tets.subfaces;
-        let blocked = |v: [VertexId; 4], f: usize| {
-            subfaces.contains_key(&face_key(FACE_VERTS[f].map(|k| v[k])))
-        };
-        let Ok(conflict) = self.tets.dt.walled_conflict(*m, pert, blocked) else {
+        let Ok(conflict) = self.tets.walled_conflict(*m, pert) else {
             return 0.0;
         };
         let mut r = f64::INFINITY;

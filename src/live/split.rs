@@ -7,7 +7,9 @@ use super::{Cdt, InsertError, Tets};
 use crate::constrained::cdt::{edge_key, face_key};
 use crate::constrained::free;
 use crate::delaunay::Walled;
-use crate::geom::encroach::{circumcenter, in_diametral_ball, near_segment, near_triangle};
+use crate::geom::encroach::{
+    circumcenter, in_diametral_ball, in_equatorial_ball, near_segment, near_triangle,
+};
 use crate::geom::Point;
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
 
@@ -44,20 +46,21 @@ pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point, tol: f64) -> Optio
 
 /// A subsegment of the walled cavity of `p` whose diametral ball holds `p`, if any (the
 /// one with the lowest key, so that the choice does not depend on hashing); `skip` is
-/// left out (the subsegment `p` splits).
-fn encroached_except(
+/// left out (the subsegment `p` splits). With `faces`, also a subface of it whose
+/// equatorial ball holds `p` (the lowest key).
+pub(super) fn encroached_constraints(
     tets: &mut Tets,
     p: &Point,
     pert: u32,
     skip: Option<(VertexId, VertexId)>,
-) -> Option<(VertexId, VertexId)> {
-    let subfaces = &tets.subfaces;
-    let blocked = |v: [VertexId; 4], f: usize| {
-        let fv = FACE_VERTS[f].map(|k| v[k]);
-        subfaces.contains_key(&face_key(fv))
+    faces: bool,
+) -> (Option<(VertexId, VertexId)>, Option<[VertexId; 3]>) {
+    let Ok(conflict) = tets.walled_conflict(*p, pert) else {
+        return (None, None);
     };
-    let conflict = tets.dt.walled_conflict(*p, pert, blocked).ok()?;
-    let mut found: Option<(VertexId, VertexId)> = None;
+    let pt = |x: VertexId| &tets.dt.points[x as usize];
+    let mut seg: Option<(VertexId, VertexId)> = None;
+    let mut face: Option<[VertexId; 3]> = None;
     for t in conflict {
         let v = tets.dt.mesh.verts(t);
         for &(i, j) in &EDGE_VERTS {
@@ -65,13 +68,34 @@ fn encroached_except(
             if e.1 == GHOST || Some(e) == skip || !tets.subsegs.contains_key(&e) {
                 continue;
             }
-            let pt = |x: VertexId| &tets.dt.points[x as usize];
-            if found.is_none_or(|f| e < f) && in_diametral_ball(pt(e.0), pt(e.1), p) {
-                found = Some(e);
+            if seg.is_none_or(|f| e < f) && in_diametral_ball(pt(e.0), pt(e.1), p) {
+                seg = Some(e);
+            }
+        }
+        if !faces {
+            continue;
+        }
+        for fv in FACE_VERTS {
+            let k = face_key(fv.map(|i| v[i]));
+            if k.contains(&GHOST) || !tets.subfaces.contains_key(&k) {
+                continue;
+            }
+            if face.is_none_or(|g| k < g) && in_equatorial_ball(pt(k[0]), pt(k[1]), pt(k[2]), p) {
+                face = Some(k);
             }
         }
     }
-    found
+    (seg, face)
+}
+
+/// [`encroached_constraints`], subsegments only.
+fn encroached_except(
+    tets: &mut Tets,
+    p: &Point,
+    pert: u32,
+    skip: Option<(VertexId, VertexId)>,
+) -> Option<(VertexId, VertexId)> {
+    encroached_constraints(tets, p, pert, skip, false).0
 }
 
 /// A subsegment that point `p` encroaches upon, if any (see [`encroached_except`]).
