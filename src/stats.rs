@@ -255,95 +255,130 @@ impl Stats {
 
     /// All figures as one JSON object (for `--stats-json`).
     pub fn to_json(&self, model: &str) -> String {
-        let mut fields: Vec<(String, String)> = vec![
-            ("model".into(), json_string(model)),
-            ("input_points".into(), self.input_points.to_string()),
-            ("duplicate_points".into(), self.duplicate_points.to_string()),
-            ("output_tets".into(), self.output_tets.to_string()),
-            ("delaunay_secs".into(), json_f64(self.delaunay_secs)),
-            ("certify_secs".into(), json_f64(self.certify_secs)),
-            ("total_secs".into(), json_f64(self.total_secs)),
+        let mut body = vec![format!("\"model\": {}", json_string(model))];
+        body.extend(
+            self.fields()
+                .iter()
+                .map(|(k, v)| format!("\"{k}\": {}", v.to_json())),
+        );
+        format!("{{{}}}", body.join(", "))
+    }
+
+    /// All figures as named, typed values, in the order `--stats-json` writes them (the
+    /// Python package's `stats` dict is made of these too).
+    pub fn fields(&self) -> Vec<(&'static str, StatValue)> {
+        use StatValue::{Count, Number, Text};
+        let mut fields = vec![
+            ("input_points", Count(self.input_points)),
+            ("duplicate_points", Count(self.duplicate_points)),
+            ("output_tets", Count(self.output_tets)),
+            ("delaunay_secs", Number(self.delaunay_secs)),
+            ("certify_secs", Number(self.certify_secs)),
+            ("total_secs", Number(self.total_secs)),
         ];
         if let Some(q) = &self.quality {
-            let hist: Vec<String> = q.dihedral_histogram.iter().map(|n| n.to_string()).collect();
             fields.extend([
-                ("max_radius_edge_ratio".into(), json_f64(q.max_ratio)),
-                ("min_dihedral".into(), json_f64(q.min_dihedral)),
-                ("max_dihedral".into(), json_f64(q.max_dihedral)),
-                ("min_volume".into(), json_f64(q.volume_range.0)),
-                ("max_volume".into(), json_f64(q.volume_range.1)),
+                ("max_radius_edge_ratio", Number(q.max_ratio)),
+                ("min_dihedral", Number(q.min_dihedral)),
+                ("max_dihedral", Number(q.max_dihedral)),
+                ("min_volume", Number(q.volume_range.0)),
+                ("max_volume", Number(q.volume_range.1)),
                 (
-                    "dihedral_histogram".into(),
-                    format!("[{}]", hist.join(", ")),
+                    "dihedral_histogram",
+                    StatValue::Counts(q.dihedral_histogram.to_vec()),
                 ),
             ]);
         }
         if let Some(p) = &self.plc {
-            let pairs: [(&str, String); 26] = [
-                ("refine_points", p.refine_points.to_string()),
-                ("refine_left", p.refine_left.to_string()),
-                ("refine_secs", json_f64(p.refine_secs)),
-                ("input_polygons", p.input_polygons.to_string()),
-                ("steiner_points", p.steiner_points.to_string()),
-                ("facet_steiner_points", p.facet_steiner_points.to_string()),
-                ("free_steiner_points", p.free_steiner_points.to_string()),
-                ("flat_tets_left", p.flat_tets_left.to_string()),
-                ("thick_tets_left", p.thick_tets_left.to_string()),
-                ("free_searches_cut", p.free_searches_cut.to_string()),
-                ("output_subfaces", p.output_subfaces.to_string()),
-                ("recovered_subfaces", p.recovered_subfaces.to_string()),
-                ("max_region_subfaces", p.max_region_subfaces.to_string()),
-                ("regions", p.regions.to_string()),
-                ("crossing_tets", p.crossing_tets.to_string()),
+            fields.extend([
+                ("refine_points", Count(p.refine_points)),
+                ("refine_left", Count(p.refine_left)),
+                ("refine_secs", Number(p.refine_secs)),
+                ("input_polygons", Count(p.input_polygons)),
+                ("steiner_points", Count(p.steiner_points)),
+                ("facet_steiner_points", Count(p.facet_steiner_points)),
+                ("free_steiner_points", Count(p.free_steiner_points)),
+                ("flat_tets_left", Count(p.flat_tets_left)),
+                ("thick_tets_left", Count(p.thick_tets_left)),
+                ("free_searches_cut", Count(p.free_searches_cut)),
+                ("output_subfaces", Count(p.output_subfaces)),
+                ("recovered_subfaces", Count(p.recovered_subfaces)),
+                ("max_region_subfaces", Count(p.max_region_subfaces)),
+                ("regions", Count(p.regions)),
+                ("crossing_tets", Count(p.crossing_tets)),
                 (
                     "max_region_crossing_tets",
-                    p.max_region_crossing_tets.to_string(),
+                    Count(p.max_region_crossing_tets),
                 ),
-                ("enlarged_tets", p.enlarged_tets.to_string()),
-                ("restarts", p.restarts.to_string()),
-                ("in_place_splits", p.in_place_splits.to_string()),
-                ("in_place_off", p.in_place_off.to_string()),
-                ("segment_secs", json_f64(p.segment_secs)),
-                ("surface_secs", json_f64(p.surface_secs)),
-                ("facet_secs", json_f64(p.facet_secs)),
-                ("carve_secs", json_f64(p.carve_secs)),
+                ("enlarged_tets", Count(p.enlarged_tets)),
+                ("restarts", Count(p.restarts)),
+                ("in_place_splits", Count(p.in_place_splits)),
+                ("in_place_off", StatValue::Flag(p.in_place_off)),
+                ("segment_secs", Number(p.segment_secs)),
+                ("surface_secs", Number(p.surface_secs)),
+                ("facet_secs", Number(p.facet_secs)),
+                ("carve_secs", Number(p.carve_secs)),
                 (
                     "facet_algorithm",
-                    json_string(match p.inserter {
+                    Text(match p.inserter {
                         crate::constrained::FacetInserter::Cavity => "cavity",
                         crate::constrained::FacetInserter::Flip => "flip",
                     }),
                 ),
-                ("plc", "true".into()),
-            ];
-            fields.extend(pairs.into_iter().map(|(k, v)| (k.to_string(), v)));
+                ("plc", StatValue::Flag(true)),
+            ]);
             let f = &p.flips;
-            let flips: [(&str, usize); 13] = [
-                ("flips", f.total()),
-                ("flips_2_3", f.flips23),
-                ("flips_3_2", f.flips32),
-                ("flips_4_4", f.flips44),
-                ("repair_flips", f.repair_flips),
-                ("safeguard_outside_r", f.outside_r),
-                ("safeguard_not_regular", f.not_regular),
-                ("safeguard_deferred", f.deferred),
-                ("flips_refused_by_constraints", f.constrained),
-                ("exact_flip_time_compares", f.exact_compares),
-                ("flip_fallbacks", f.fallbacks),
-                ("flip_not_flat_stuck", f.not_flat_stuck),
-                ("flip_not_flat_cavity_points", f.not_flat_cavity_points),
-            ];
-            fields.extend(
-                flips
-                    .into_iter()
-                    .map(|(k, v)| (k.to_string(), v.to_string())),
-            );
+            fields.extend([
+                ("flips", Count(f.total())),
+                ("flips_2_3", Count(f.flips23)),
+                ("flips_3_2", Count(f.flips32)),
+                ("flips_4_4", Count(f.flips44)),
+                ("repair_flips", Count(f.repair_flips)),
+                ("safeguard_outside_r", Count(f.outside_r)),
+                ("safeguard_not_regular", Count(f.not_regular)),
+                ("safeguard_deferred", Count(f.deferred)),
+                ("flips_refused_by_constraints", Count(f.constrained)),
+                ("exact_flip_time_compares", Count(f.exact_compares)),
+                ("flip_fallbacks", Count(f.fallbacks)),
+                ("flip_not_flat_stuck", Count(f.not_flat_stuck)),
+                (
+                    "flip_not_flat_cavity_points",
+                    Count(f.not_flat_cavity_points),
+                ),
+            ]);
         }
-        let body: Vec<String> = fields
-            .iter()
-            .map(|(k, v)| format!("\"{k}\": {v}"))
-            .collect();
-        format!("{{{}}}", body.join(", "))
+        fields
+    }
+}
+
+/// One figure of [`Stats::fields`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum StatValue {
+    /// A count.
+    Count(usize),
+    /// A measurement (seconds, angles, volumes); not finite when undefined.
+    Number(f64),
+    /// A name.
+    Text(&'static str),
+    /// A yes/no figure.
+    Flag(bool),
+    /// Counts per bin.
+    Counts(Vec<usize>),
+}
+
+impl StatValue {
+    /// The value as JSON.
+    pub fn to_json(&self) -> String {
+        match self {
+            StatValue::Count(n) => n.to_string(),
+            StatValue::Number(x) => json_f64(*x),
+            StatValue::Text(s) => json_string(s),
+            StatValue::Flag(b) => b.to_string(),
+            StatValue::Counts(v) => {
+                let items: Vec<String> = v.iter().map(|n| n.to_string()).collect();
+                format!("[{}]", items.join(", "))
+            }
+        }
     }
 }
 
