@@ -94,6 +94,19 @@ pub enum MeshError {
         /// Why its triangulation failed.
         reason: String,
     },
+    /// `-Y`: the CDT made has Steiner points on the PLC's segments or facets.
+    #[error(
+        "-Y: the boundary cannot be kept as given: recovering the segments and facets put \
+         {points} Steiner point(s) on them, the first at ({}, {}, {}); without -Y they are \
+         kept",
+        first[0], first[1], first[2]
+    )]
+    BoundaryChanged {
+        /// How many Steiner points lie on segments and facets.
+        points: usize,
+        /// The first of them (in node order).
+        first: [f64; 3],
+    },
     /// A construction passed its bound on work ([`crate::constrained::cdt::Cdt::work_limit`]):
     /// the restarts end as if it had finished over the bound.
     #[error("the construction passed its bound on work")]

@@ -32,6 +32,11 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -c     Keep the convex hull: mesh the hull instead of carving the exterior (needs -p)
   -A     Give each tet the attribute of its region from the region list (needs -p)
   -M     Do not merge coplanar adjacent facets (needs -p)
+  -q[r][/d] Refine until no tet has a radius-edge ratio over r (default 2) or, with
+         /d, a dihedral angle under d degrees; the mesh stays a CDT (needs -p)
+  -a[v]  Refine until no tet is larger than v; -a alone: each region's bound (needs -p)
+  -Y     No Steiner point on segments and facets: refinement leaves the tets that
+         would need one, and a PLC whose CDT needs one fails (exit 1; needs -p)
   -S[n]  At most n Steiner points (-S or -S0: no limit); reaching it is an error
   -J     Keep the input points that no tet uses (repeated points, points outside the
          domain or in holes) in .node; by default they are left out, as TetGen does
@@ -43,7 +48,7 @@ Switches (TetGen style, packed after one '-', e.g. -zQ or -fenV):
   -V     Verbose: print statistics (-VV for more)
   -d     Only detect intersecting facets: list them, write their triangles to .face
          (with the points in .node); nothing is written when there are none
-Other TetGen switches (-q, -a, -r, -Y, -T, -o2, -G, -K, ...) are recognised and refused.
+Other TetGen switches (-r, -T, -o2, -G, -K, ...) are recognised and refused.
 
 Switches may come before or after FILE; put -- before a FILE whose name starts with '-'.
 

@@ -81,6 +81,9 @@ pub struct Options {
     pub max_volume: Option<f64>,
     /// `-a` without a number: the volume bounds of the `.poly` file's regions; needs `-p`.
     pub region_volumes: bool,
+    /// `-Y`: no Steiner point on the boundary (segments and facets keep their input
+    /// vertices); a mesh that needs one is a failure; needs `-p`.
+    pub keep_boundary: bool,
 }
 
 /// The bounds of `-q`: TetGen's defaults are a radius-edge ratio of 2 and no dihedral
@@ -210,7 +213,6 @@ enum Arg {
 /// A TetGen switch we recognise but refuse: letter, argument, description.
 const REFUSED: &[(char, Arg, &str)] = &[
     ('r', Arg::None, "reconstruct a previous mesh"),
-    ('Y', Arg::Numbers, "preserve the input surface mesh"),
     ('i', Arg::None, "insert additional points"),
     ('m', Arg::None, "mesh sizing function"),
     ('T', Arg::Numbers, "coplanarity tolerance"),
@@ -248,6 +250,7 @@ const NEED_PLC: &[(char, &str)] = &[
     ('A', "region attributes"),
     ('q', "quality mesh generation"),
     ('a', "maximum volume constraint"),
+    ('Y', "boundary preservation"),
 ];
 
 /// What the parser noticed across all switch strings, for the checks made at the end.
@@ -260,11 +263,19 @@ struct Seen {
     regions: bool,
     quality: bool,
     volume: bool,
+    keep_boundary: bool,
     jettison: bool,
     problems: Vec<SwitchProblem>,
 }
 
 impl Options {
+    /// Whether coplanar neighbouring facets merge into one: not with `-M`, and not with
+    /// `-Y`, whose boundary is the input's polygons as given (a merged facet's inner
+    /// edges are free to change).
+    pub fn merges_facets(&self) -> bool {
+        !(self.no_merge || self.keep_boundary)
+    }
+
     /// Parses switch strings (each `-` + packed switches) into options, starting from the
     /// defaults; returns every problem found if any switch is refused.
     pub fn from_switches<'a, I>(switches: I) -> Result<Options, SwitchError>
@@ -379,6 +390,11 @@ impl Options {
                 }
                 'J' => {
                     self.keep_unused = true;
+                    true
+                }
+                'Y' => {
+                    self.keep_boundary = true;
+                    seen.keep_boundary = true;
                     true
                 }
                 _ => false,
@@ -514,6 +530,7 @@ impl Options {
                     'c' => seen.keep_hull,
                     'q' => seen.quality,
                     'a' => seen.volume,
+                    'Y' => seen.keep_boundary,
                     _ => seen.regions,
                 };
                 if given {
@@ -753,7 +770,8 @@ mod tests {
             (&["-pa0"], &["-a does not take the argument \"0\""]),
             (&["-pa1/2"], &["-a does not take the argument \"1/2\""]),
             (&["-r"], &["-r (reconstruct"]),
-            (&["-Y"], &["-Y (preserve"]),
+            (&["-Y"], &["-Y (boundary preservation) needs -p"]),
+            (&["-pY1"], &["-Y does not take the argument \"1\""]),
             (&["-A"], &["-A (region attributes) needs -p"]),
             (&["-c"], &["-c (convex hull retention) needs -p"]),
             (&["-M"], &["-M (no merging of coplanar facets) needs -p"]),

@@ -85,7 +85,7 @@ fn run_points(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshe
 fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, Error> {
     let start = Instant::now();
     let popts = crate::constrained::PlcOptions {
-        merge: !opts.no_merge,
+        merge: opts.merges_facets(),
         keep_hull: opts.keep_hull,
         region_attributes: opts.region_attributes,
         // Without -S, a generous bound still guarantees that every run ends.
@@ -126,6 +126,7 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
             min_dihedral: opts.quality.map(|q| q.min_dihedral),
             max_volume: opts.max_volume,
             region_volumes: opts.region_volumes,
+            keep_boundary: opts.keep_boundary,
         };
         let done = mesh_plc_with_progress(plc, &popts, (&refine, opts.max_steiner), progress);
         checker.thread().unpark();
@@ -137,6 +138,9 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
     let (checked, precheck_secs) = checked;
     let mut warnings = checked?;
     let done = done?;
+    if opts.keep_boundary {
+        boundary_kept(plc, &done.mesh)?;
+    }
     // Exit 0 means a valid CDT: the mesh is certified from its nodes and tets alone
     // before anyone gets it.
     let t_certify = Instant::now();
@@ -175,6 +179,26 @@ fn run_plc(plc: &Plc, opts: &Options, progress: Progress<'_>) -> Result<Meshed, 
         stats,
         warnings,
     })
+}
+
+/// `-Y`: an error if `mesh` has Steiner points on the segments or facets (its first
+/// nodes are the input points, in order; refinement under `-Y` adds none there, so any
+/// come from recovering the segments and facets).
+fn boundary_kept(plc: &Plc, mesh: &MeshOut) -> Result<(), MeshError> {
+    let inputs = plc.points.len();
+    let faces = mesh.subfaces.iter().flat_map(|(f, _)| *f);
+    let edges = mesh.subsegments.iter().flat_map(|(e, _)| *e);
+    let on: rustc_hash::FxHashSet<u32> = faces
+        .chain(edges)
+        .filter(|&v| v as usize >= inputs)
+        .collect();
+    match on.iter().min() {
+        None => Ok(()),
+        Some(&first) => Err(MeshError::BoundaryChanged {
+            points: on.len(),
+            first: mesh.points[first as usize],
+        }),
+    }
 }
 
 /// The finished PLC mesh, its figures, and warnings for the user.

@@ -14,6 +14,8 @@ struct Refined {
     points: Vec<[f64; 3]>,
     tets: Vec<[usize; 4]>,
     attributes: Vec<f64>,
+    /// The faces on facets (`.face`), by their corners' coordinates.
+    faces: Vec<[[f64; 3]; 3]>,
     /// `refine_left` from `--stats-json`.
     left: usize,
 }
@@ -69,13 +71,18 @@ fn refine(model: &Path, switches: &str) -> Refined {
         .success();
     let node = numbers(&prefix.with_extension("node"));
     let first = node[1][0] as usize;
-    let points = node[1..].iter().map(|r| [r[1], r[2], r[3]]).collect();
+    let points: Vec<[f64; 3]> = node[1..].iter().map(|r| [r[1], r[2], r[3]]).collect();
     let ele = numbers(&prefix.with_extension("ele"));
     let tets = ele[1..]
         .iter()
         .map(|r| std::array::from_fn(|k| r[k + 1] as usize - first))
         .collect();
     let attributes = ele[1..].iter().filter_map(|r| r.get(5).copied()).collect();
+    let face = numbers(&prefix.with_extension("face"));
+    let faces = face[1..]
+        .iter()
+        .map(|r| std::array::from_fn(|k| points[r[k + 1] as usize - first]))
+        .collect();
     let json = fs::read_to_string(&stats).unwrap();
     let left = json
         .split("\"refine_left\": ")
@@ -87,6 +94,7 @@ fn refine(model: &Path, switches: &str) -> Refined {
         points,
         tets,
         attributes,
+        faces,
         left,
     }
 }
@@ -261,4 +269,102 @@ fn refinement_ends_at_small_input_angles() {
             );
         }
     }
+}
+
+/// Triangles as sorted lists of sorted corners, for comparing boundaries.
+fn triangle_set(faces: &[[[f64; 3]; 3]]) -> Vec<[[u64; 3]; 3]> {
+    let mut set: Vec<[[u64; 3]; 3]> = faces
+        .iter()
+        .map(|f| {
+            let mut t = f.map(|p| p.map(f64::to_bits));
+            t.sort();
+            t
+        })
+        .collect();
+    set.sort();
+    set
+}
+
+/// A regular tetrahedron's surface, each face cut into 16 triangles (a triangulated
+/// input whose triangles are no Delaunay accident: no four points are cospherical on a
+/// face), as the points and triangles of an `.off` file written to `path`.
+fn subdivided_tetrahedron(path: &Path) -> Vec<[[f64; 3]; 3]> {
+    let corners = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 0.75f64.sqrt(), 0.0],
+        [0.5, 0.75f64.sqrt() / 3.0, (2.0f64 / 3.0).sqrt()],
+    ];
+    let mut tris: Vec<[[f64; 3]; 3]> = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]
+        .iter()
+        .map(|f| f.map(|i| corners[i]))
+        .collect();
+    let mid = |a: [f64; 3], b: [f64; 3]| std::array::from_fn(|k| (a[k] + b[k]) / 2.0);
+    for _ in 0..2 {
+        tris = tris
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut index = |p: [f64; 3]| match points.iter().position(|&q| q == p) {
+        Some(i) => i,
+        None => {
+            points.push(p);
+            points.len() - 1
+        }
+    };
+    let faces: Vec<[usize; 3]> = tris.iter().map(|t| t.map(&mut index)).collect();
+    let mut off = format!("OFF\n{} {} 0\n", points.len(), faces.len());
+    for p in &points {
+        off += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in &faces {
+        off += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+    }
+    fs::write(path, off).unwrap();
+    tris
+}
+
+#[test]
+fn keep_boundary_leaves_the_input_triangles_as_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("tet16.off");
+    let input = triangle_set(&subdivided_tetrahedron(&model));
+    assert_eq!(input.len(), 64);
+
+    let kept = refine(&model, "-pq1.2/10a0.0001Y");
+    assert!(kept.points.len() > 34, "refinement added interior points");
+    assert_eq!(
+        triangle_set(&kept.faces),
+        input,
+        "-Y keeps every input triangle"
+    );
+    // The tets -Y leaves (their circumcentres encroach upon the boundary) are counted.
+    assert!(kept.left > 0 && kept.over_ratio(1.2) <= kept.left);
+    // Without -Y the same bounds split the boundary (so the test tells the two apart).
+    let free = refine(&model, "-pq1.2/10a0.0001");
+    assert_ne!(triangle_set(&free.faces), input);
+}
+
+#[test]
+fn keep_boundary_refuses_a_plc_whose_cdt_needs_boundary_points() {
+    // Schönhardt's twisted prism: its CDT needs Steiner points on its segments.
+    let out = Command::cargo_bin("tetcdt")
+        .unwrap()
+        .args(["-pYQ", "-o"])
+        .arg(tempfile::tempdir().unwrap().path().join("out"))
+        .arg(example("plc/schonhardt.off"))
+        .assert()
+        .code(1);
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    assert!(
+        stderr.contains("-Y: the boundary cannot be kept as given") && stderr.contains("Steiner"),
+        "{stderr}"
+    );
+    // Without -Y it meshes, with those points.
+    refine(&example("plc/schonhardt.off"), "-p");
 }

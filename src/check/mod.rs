@@ -156,7 +156,7 @@ impl CertifyOptions {
     pub fn of(opts: &crate::options::Options) -> Self {
         CertifyOptions {
             keep_hull: opts.keep_hull,
-            merge: !opts.no_merge,
+            merge: opts.merges_facets(),
         }
     }
 }

@@ -65,6 +65,10 @@ pub enum InsertError {
     /// configuration the splits do not cover.
     #[error("the point {0:?} fits no cavity of the CDT")]
     Refused(Point),
+    /// The point needs a split of a subsegment or subface, and the boundary is kept
+    /// (`-Y`).
+    #[error("the point {0:?} needs a split of the boundary, which is kept")]
+    BoundaryKept(Point),
 }
 
 /// What [`Cdt::insert_vertex`] did.
@@ -112,6 +116,8 @@ pub struct Cdt {
     /// (many bad tets lead to the same split, through the constraints they encroach
     /// upon, and the CDT around it rarely changes in between).
     refused_splits: Option<rustc_hash::FxHashSet<[u64; 3]>>,
+    /// While refining under `-Y`: no subsegment or subface may be split.
+    keep_boundary: bool,
 }
 
 impl Cdt {
@@ -148,6 +154,7 @@ impl Cdt {
             next_pert,
             added: 0,
             refused_splits: None,
+            keep_boundary: false,
         }
     }
 

@@ -11,6 +11,10 @@
 //!   subfaces, or their subsegments when those encroach);
 //! - beyond a subface (outside the tet's side of it), that subface is split.
 //!
+//! Under `-Y` ([`RefineParameters::keep_boundary`]) no constraint is split: a tet whose
+//! circumcentre encroaches upon a constraint or lies beyond a subface is left (its
+//! circumcentre would make tets against the boundary that no split could mend).
+//!
 //! The point a bad tet asks for must lie at least half the tet's shortest edge from every
 //! vertex of its cavity (never less than a fixed floor): a circumcentre always does, and a
 //! split point closer than that comes from a small input angle, where splitting would
@@ -37,6 +41,9 @@ pub struct RefineParameters {
     pub max_volume: Option<f64>,
     /// Whether each region's volume bound from the PLC applies too (`-a`).
     pub region_volumes: bool,
+    /// No split of a subsegment or subface (`-Y`): only circumcentres inside the domain
+    /// that encroach upon nothing go in, and the tets that need more are left.
+    pub keep_boundary: bool,
 }
 
 impl RefineParameters {
@@ -100,8 +107,10 @@ impl Cdt {
         }
         let floor = self.insertion_floor(params);
         self.refused_splits = Some(FxHashSet::default());
+        self.keep_boundary = params.keep_boundary;
         let result = self.refine_passes(params, floor);
         self.refused_splits = None;
+        self.keep_boundary = false;
         result
     }
 
@@ -309,6 +318,9 @@ impl Cdt {
             let (v, _, _) = self.insert_vertex_id(c)?;
             return Ok(Some((self.added - before, Some(v))));
         };
+        if self.keep_boundary {
+            return Ok(None);
+        }
         let m = match e {
             Encroached::Subsegment(a, b) => self.edge_split_point(a, b),
             Encroached::Subface(f) => {

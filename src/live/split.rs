@@ -157,6 +157,10 @@ impl Cdt {
     /// its own, and a subface's circumcentre that does is dropped for it (Shewchuk's
     /// rule). The number of points added.
     fn run_splits(&mut self, first: Target) -> Result<usize, InsertError> {
+        if self.keep_boundary {
+            let at = self.split_point(first).unwrap_or([f64::NAN; 3]);
+            return Err(InsertError::BoundaryKept(at));
+        }
         let bound = self.split_bound();
         let mut stack = vec![first];
         let mut made = 0;
