@@ -368,3 +368,21 @@ fn keep_boundary_refuses_a_plc_whose_cdt_needs_boundary_points() {
     // Without -Y it meshes, with those points.
     refine(&example("plc/schonhardt.off"), "-p");
 }
+
+#[test]
+fn refinement_keeps_every_vertex_of_the_domain() {
+    // Splits near the apex of a triangulated tetrahedron once took every tet around the
+    // apex into their cavity and dropped it, with its segments (carving then refused
+    // the mesh). Every input point must stay a node.
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("tet16.off");
+    let triangles = subdivided_tetrahedron(&model);
+    for switches in ["-pa0.001", "-pq1.2/10a0.001"] {
+        let r = refine(&model, switches);
+        for t in &triangles {
+            for p in t {
+                assert!(r.points.contains(p), "{switches}: {p:?} lost");
+            }
+        }
+    }
+}

@@ -682,6 +682,20 @@ impl Delaunay {
         directed.iter().all(|&(a, c)| directed.contains(&(c, a)))
     }
 
+    /// Whether every vertex of the cavity's tets lies on its boundary. A Delaunay cavity
+    /// never holds a vertex inside, but a seeded or walled one can take every tet around
+    /// a vertex (a split point near a corner of the domain): filling it would drop that
+    /// vertex, and the constraints at it, from the mesh.
+    pub(crate) fn encloses_no_vertex(&self) -> bool {
+        let on: rustc_hash::FxHashSet<VertexId> = self.boundary.iter().flat_map(|b| b.v).collect();
+        self.conflict.iter().all(|&t| {
+            self.mesh
+                .verts(t)
+                .iter()
+                .all(|v| *v == GHOST || on.contains(v))
+        })
+    }
+
     /// Whether every real tet the cavity's fill would make is positively oriented. True of
     /// every Delaunay cavity, but in a constrained tetrahedralization a cavity need not be
     /// seen whole from the new point: it may wrap around a wall, or (found by fuzzing

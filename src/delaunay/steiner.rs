@@ -115,7 +115,11 @@ impl Delaunay {
         let v = self.push_point(p, pert);
         let mut found = self.blocked_cavity(v, &blocked);
         let ready = matches!(found, Ok(super::Cavity::Ready));
-        if ready && !(self.boundary_is_a_sphere() && self.fill_is_positive()) {
+        if ready
+            && !(self.boundary_is_a_sphere()
+                && self.encloses_no_vertex()
+                && self.fill_is_positive())
+        {
             self.abandon_cavity();
             found = Ok(super::Cavity::Wraps);
         }
@@ -194,7 +198,11 @@ impl Delaunay {
         let grown = self.grow_cavity(v, seeds, &blocked);
         let ready = matches!(grown, super::Cavity::Ready)
             && self.shrink_to_star(v, seeds, &blocked, unfillable);
-        if !(ready && self.boundary_is_a_sphere() && self.fill_is_positive()) {
+        if !(ready
+            && self.boundary_is_a_sphere()
+            && self.encloses_no_vertex()
+            && self.fill_is_positive())
+        {
             if ready {
                 self.abandon_cavity();
             }
