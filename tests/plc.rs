@@ -1087,3 +1087,17 @@ fn csg_parts_rounded_to_six_digits_mesh_validly() {
     });
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// With the convex hull kept (`-c`), merged groups that are not exactly flat are meshed
+/// as their separate facets: the flat tets outside such a group would otherwise be kept
+/// with the exterior and cover it a second time. CSG parts with coordinates rounded to 6
+/// digits have many; the certifier accepts every run (exit 0).
+#[test]
+fn keep_hull_meshes_parts_with_bent_merged_facets() {
+    let dir = tempfile::tempdir().unwrap();
+    let part = plc_dir().join("../csg/flange_7.off");
+    for args in [["-pcQ"], ["-pcFQ"]] {
+        let prefix = mesh(&part, dir.path(), "flange", &args);
+        assert!(!read_mesh(&prefix).tets.is_empty());
+    }
+}
