@@ -154,17 +154,22 @@ fn batch_summary_records_and_exit_code() {
             "steiner_points",
             "tets",
             "seconds",
+            "max_radius_edge_ratio",
+            "min_dihedral",
+            "refine_left",
             "reason"
         ]
     );
     assert_eq!(rows.len(), names.len() + 1);
     for (name, row) in names.iter().zip(&rows[1..]) {
-        assert_eq!(row.len(), 8, "{tsv}");
+        assert_eq!(row.len(), 11, "{tsv}");
+        // -pQ computes no quality figures: their fields are empty.
+        assert_eq!(row[7..10], ["", "", ""]);
         assert_eq!(row[0], name);
         if name == "broken.off" {
             assert_eq!(row[1..6], ["failed", "3", "", "", ""]);
             assert_eq!(
-                row[7],
+                row[10],
                 "broken.off:6: face 0 has corner 7, but there are only 3 vertices (numbered from 0)"
             );
         } else {
@@ -172,7 +177,7 @@ fn batch_summary_records_and_exit_code() {
             assert_eq!(row[1..3], ["ok", "0"]);
             assert_eq!(row[3], points.to_string());
             assert_eq!(row[5], tets.to_string());
-            assert_eq!(row[7], "");
+            assert_eq!(row[10], "");
         }
     }
 
@@ -614,4 +619,63 @@ fn table1_script_tabulates_ours_beside_tetgen() {
     );
     // Nothing is written beside the models.
     assert_eq!(fs::read_dir(&models).unwrap().count(), 3);
+}
+
+#[test]
+fn quality_batch_summary_has_quality_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let names = setup(d);
+    let good: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| *n != "broken.off")
+        .take(3)
+        .collect();
+    let mut args = vec!["-pq1.414Q", "--summary", "q.tsv"];
+    args.extend(&good);
+    let (code, stdout, stderr) = run_in(d, &args);
+    assert_eq!(code, 0, "{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(
+        lines[0]
+            .split("  ")
+            .filter(|c| !c.is_empty())
+            .map(str::trim)
+            .collect::<Vec<_>>(),
+        [
+            "model",
+            "status",
+            "vertices",
+            "Steiner",
+            "tets",
+            "seconds",
+            "max ratio",
+            "min dihedral",
+            "left"
+        ],
+        "{stdout}"
+    );
+    let tsv = fs::read_to_string(d.join("q.tsv")).unwrap();
+    for row in tsv.lines().skip(1) {
+        let cells: Vec<&str> = row.split('\t').collect();
+        let ratio: f64 = cells[7].parse().unwrap();
+        let angle: f64 = cells[8].parse().unwrap();
+        let left: usize = cells[9].parse().unwrap();
+        // Every tet meets the bound, but those counted as left.
+        assert!(ratio <= 1.414 || left > 0, "{row}");
+        assert!(angle > 0.0 && angle < 90.0, "{row}");
+        // The table shows the same figures.
+        let line = lines.iter().find(|l| l.starts_with(cells[0])).unwrap();
+        let shown: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(
+            shown[shown.len() - 3..],
+            [
+                format!("{ratio:.3}"),
+                format!("{angle:.2}"),
+                left.to_string()
+            ],
+            "{line}"
+        );
+    }
 }

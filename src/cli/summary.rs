@@ -18,6 +18,9 @@ pub struct Row {
     pub reason: String,
     /// Nodes, Steiner points and tets written, for successful models.
     pub figures: Option<[usize; 3]>,
+    /// The worst radius-edge ratio, the smallest dihedral angle and the tets refinement
+    /// left over its bounds, where the run computed them (`-q`, `-a`, `-V`).
+    pub quality: Option<(f64, f64, usize)>,
     /// Wall seconds.
     pub secs: f64,
 }
@@ -25,22 +28,30 @@ pub struct Row {
 impl Row {
     /// The row of a finished model.
     pub fn of(report: &ModelReport) -> Row {
-        let (code, reason, figures) = match &report.result {
+        let (code, reason, figures, quality) = match &report.result {
             Ok(done) => {
                 let steiner = done.stats.plc.as_ref().map_or(0, |p| p.steiner_points);
+                let left = done.stats.plc.as_ref().map_or(0, |p| p.refine_left);
+                let quality = done
+                    .stats
+                    .quality
+                    .as_ref()
+                    .map(|q| (q.max_ratio, q.min_dihedral, left));
                 (
                     0,
                     String::new(),
                     Some([done.points, steiner, done.stats.output_tets]),
+                    quality,
                 )
             }
-            Err(f) => (f.code, first_line(&error_chain(&f.err)), None),
+            Err(f) => (f.code, first_line(&error_chain(&f.err)), None, None),
         };
         Row {
             model: report.file.display().to_string(),
             code,
             reason,
             figures,
+            quality,
             secs: report.secs,
         }
     }
@@ -70,21 +81,42 @@ fn clip(s: &str, width: usize) -> String {
     out
 }
 
-/// The summary as an aligned text table with a closing count line.
+/// The quality figures of a row as text: worst ratio, smallest dihedral angle, tets left.
+fn quality_cells(r: &Row) -> [String; 3] {
+    match r.quality {
+        Some((ratio, angle, left)) => [
+            format!("{ratio:.3}"),
+            format!("{angle:.2}"),
+            left.to_string(),
+        ],
+        None => ["-".into(), "-".into(), "-".into()],
+    }
+}
+
+/// The summary as an aligned text table with a closing count line; the quality columns
+/// appear when a model has quality figures.
 pub fn table(rows: &[Row]) -> String {
-    let head = ["model", "status", "vertices", "Steiner", "tets", "seconds"];
-    let cells: Vec<[String; 6]> = rows
+    let with_quality = rows.iter().any(|r| r.quality.is_some());
+    let mut head = vec!["model", "status", "vertices", "Steiner", "tets", "seconds"];
+    if with_quality {
+        head.extend(["max ratio", "min dihedral", "left"]);
+    }
+    let cells: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
             let fig = |i: usize| r.figures.map_or("-".to_string(), |f| f[i].to_string());
-            [
+            let mut c = vec![
                 r.model.clone(),
                 clip(&r.status(), STATUS_WIDTH),
                 fig(0),
                 fig(1),
                 fig(2),
                 format!("{:.3}", r.secs),
-            ]
+            ];
+            if with_quality {
+                c.extend(quality_cells(r));
+            }
+            c
         })
         .collect();
     let mut width: Vec<usize> = head.iter().map(|h| h.chars().count()).collect();
@@ -108,7 +140,8 @@ pub fn table(rows: &[Row]) -> String {
         }
         s.trim_end().to_owned() + "\n"
     };
-    let mut out = line(&head.map(String::from));
+    let head: Vec<String> = head.into_iter().map(String::from).collect();
+    let mut out = line(&head);
     for c in &cells {
         out.push_str(&line(c));
     }
@@ -122,15 +155,22 @@ pub fn table(rows: &[Row]) -> String {
     out
 }
 
-/// The summary as TSV with a header line (`--summary FILE`); figures of failed models
-/// are empty fields.
+/// The summary as TSV with a header line (`--summary FILE`); figures of failed models,
+/// and quality figures a run did not compute, are empty fields.
 pub fn tsv(rows: &[Row]) -> String {
-    let mut out =
-        String::from("model\tstatus\texit_code\tvertices\tsteiner_points\ttets\tseconds\treason\n");
+    let mut out = String::from(
+        "model\tstatus\texit_code\tvertices\tsteiner_points\ttets\tseconds\t\
+         max_radius_edge_ratio\tmin_dihedral\trefine_left\treason\n",
+    );
     for r in rows {
         let fig = |i: usize| r.figures.map_or(String::new(), |f| f[i].to_string());
+        let quality = r
+            .quality
+            .map_or(["".into(), "".into(), "".into()], |(q, a, l)| {
+                [q.to_string(), a.to_string(), l.to_string()]
+            });
         out.push_str(&format!(
-            "{}\t{}\t{}\t{}\t{}\t{}\t{:.6}\t{}\n",
+            "{}\t{}\t{}\t{}\t{}\t{}\t{:.6}\t{}\t{}\t{}\t{}\n",
             r.model.replace('\t', " "),
             if r.code == 0 { "ok" } else { "failed" },
             r.code,
@@ -138,6 +178,9 @@ pub fn tsv(rows: &[Row]) -> String {
             fig(1),
             fig(2),
             r.secs,
+            quality[0],
+            quality[1],
+            quality[2],
             r.reason
         ));
     }
