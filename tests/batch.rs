@@ -54,6 +54,15 @@ fn setup(dir: &Path) -> Vec<String> {
     names
 }
 
+/// The models of `setup` that mesh.
+fn good_models(names: &[String]) -> Vec<&str> {
+    names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| *n != "broken.off")
+        .collect()
+}
+
 /// The base name of a model: `cube.poly` -> `cube`.
 fn stem(name: &str) -> &str {
     name.rsplit_once('.').unwrap().0
@@ -473,11 +482,7 @@ fn progress_bars_only_on_a_terminal() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let names = setup(d);
-    let good: Vec<&str> = names
-        .iter()
-        .map(String::as_str)
-        .filter(|n| *n != "broken.off")
-        .collect();
+    let good: Vec<&str> = good_models(&names);
     // Bars shown at once if at all: stderr is a pipe here, so none.
     for jobs in ["1", "2"] {
         let mut args = vec!["-p", "--jobs", jobs];
@@ -626,12 +631,7 @@ fn quality_batch_summary_has_quality_columns() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let names = setup(d);
-    let good: Vec<&str> = names
-        .iter()
-        .map(String::as_str)
-        .filter(|n| *n != "broken.off")
-        .take(3)
-        .collect();
+    let good: Vec<&str> = good_models(&names).into_iter().take(3).collect();
     let mut args = vec!["-pq1.414Q", "--summary", "q.tsv"];
     args.extend(&good);
     let (code, stdout, stderr) = run_in(d, &args);

@@ -235,6 +235,25 @@ fn stat_value<'py>(py: Python<'py>, v: &StatValue) -> PyResult<Bound<'py, PyAny>
     })
 }
 
+/// Cells of `N` nodes with markers (subfaces, subsegments) as an (n, N) int32 array and
+/// their markers.
+fn constrained_cells<'py, const N: usize>(
+    py: Python<'py>,
+    cells: &[([u32; N], i32)],
+) -> (Bound<'py, PyArray2<i32>>, Bound<'py, PyArray1<i32>>) {
+    let nodes: Vec<i32> = cells
+        .iter()
+        .flat_map(|(c, _)| c.map(|v| v as i32))
+        .collect();
+    let markers: Vec<i32> = cells.iter().map(|&(_, m)| m).collect();
+    (
+        Array2::from_shape_vec((cells.len(), N), nodes)
+            .expect("rows of N")
+            .into_pyarray(py),
+        Array1::from_vec(markers).into_pyarray(py),
+    )
+}
+
 /// Meshes `plc` as `switches` ask, with the GIL released, and returns the mesh as a dict
 /// of arrays (what the command line writes: without the points no tet uses, unless `J`).
 fn mesh<'py>(py: Python<'py>, plc: &Plc, switches: &str) -> PyResult<Bound<'py, PyDict>> {
@@ -276,38 +295,12 @@ fn mesh<'py>(py: Python<'py>, plc: &Plc, switches: &str) -> PyResult<Bound<'py, 
             .expect("k rows of 4")
             .into_pyarray(py),
     )?;
-    let faces: Vec<i32> = out
-        .subfaces
-        .iter()
-        .flat_map(|(f, _)| f.map(|v| v as i32))
-        .collect();
-    let face_markers: Vec<i32> = out.subfaces.iter().map(|&(_, m)| m).collect();
-    d.set_item(
-        "faces",
-        Array2::from_shape_vec((out.subfaces.len(), 3), faces)
-            .expect("rows of 3")
-            .into_pyarray(py),
-    )?;
-    d.set_item(
-        "face_markers",
-        Array1::from_vec(face_markers).into_pyarray(py),
-    )?;
-    let edges: Vec<i32> = out
-        .subsegments
-        .iter()
-        .flat_map(|(e, _)| e.map(|v| v as i32))
-        .collect();
-    let edge_markers: Vec<i32> = out.subsegments.iter().map(|&(_, m)| m).collect();
-    d.set_item(
-        "edges",
-        Array2::from_shape_vec((out.subsegments.len(), 2), edges)
-            .expect("rows of 2")
-            .into_pyarray(py),
-    )?;
-    d.set_item(
-        "edge_markers",
-        Array1::from_vec(edge_markers).into_pyarray(py),
-    )?;
+    let (faces, face_markers) = constrained_cells(py, &out.subfaces);
+    d.set_item("faces", faces)?;
+    d.set_item("face_markers", face_markers)?;
+    let (edges, edge_markers) = constrained_cells(py, &out.subsegments);
+    d.set_item("edges", edges)?;
+    d.set_item("edge_markers", edge_markers)?;
     if out.num_tet_attrs > 0 {
         // With -A each tet carries one attribute: its region's.
         let regions: Vec<f64> = out
@@ -369,6 +362,14 @@ fn tetrahedralize<'py>(
     mesh(py, &plc, switches)
 }
 
+/// Points as an (n, 3) array (a copy: the PLC keeps its own).
+fn points_array<'py>(py: Python<'py>, points: &[[f64; 3]]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = points.iter().flatten().copied().collect();
+    Array2::from_shape_vec((points.len(), 3), flat)
+        .expect("rows of 3")
+        .into_pyarray(py)
+}
+
 /// Polygons as (indices, polygon ends, facet ends).
 type FacetArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
@@ -392,10 +393,7 @@ impl PyPlc {
     /// The points, (n, 3).
     #[getter]
     fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let flat: Vec<f64> = self.plc.points.iter().flatten().copied().collect();
-        Array2::from_shape_vec((self.plc.points.len(), 3), flat)
-            .expect("rows of 3")
-            .into_pyarray(py)
+        points_array(py, &self.plc.points)
     }
 
     /// The facets' polygons as flat arrays: (indices, polygon ends, facet ends), the
@@ -435,10 +433,7 @@ impl PyPlc {
     /// The volume hole points, (h, 3).
     #[getter]
     fn holes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let flat: Vec<f64> = self.plc.holes.iter().flatten().copied().collect();
-        Array2::from_shape_vec((self.plc.holes.len(), 3), flat)
-            .expect("rows of 3")
-            .into_pyarray(py)
+        points_array(py, &self.plc.holes)
     }
 
     /// The regions, (r, 5): a point inside, the attribute and the volume bound (negative
