@@ -274,14 +274,25 @@ mod tests {
         let t = tsv(&rows);
         let lines: Vec<Vec<&str>> = t.lines().map(|l| l.split('\t').collect()).collect();
         assert_eq!(lines.len(), 3);
-        assert!(lines.iter().all(|l| l.len() == 8), "{t}");
+        assert!(lines.iter().all(|l| l.len() == 11), "{t}");
         assert_eq!(
-            lines[1][..7],
-            ["a/cube.poly", "ok", "0", "9", "0", "6", "0.250000"]
+            lines[1][..10],
+            [
+                "a/cube.poly",
+                "ok",
+                "0",
+                "9",
+                "0",
+                "6",
+                "0.250000",
+                "",
+                "",
+                ""
+            ]
         );
         assert_eq!(lines[2][..6], ["bad.off", "failed", "3", "", "", ""]);
         assert_eq!(
-            lines[2][7],
+            lines[2][10],
             "bad.off:4: polygon 1: vertex 9 is not a vertex"
         );
     }
