@@ -43,6 +43,16 @@ pub struct MeshOut {
 }
 
 impl MeshOut {
+    /// The mesh as written when it differs from this one: [`MeshOut::jettisoned`]
+    /// unless `keep_unused` (`-J`).
+    pub fn written(&self, keep_unused: bool) -> Option<MeshOut> {
+        if keep_unused {
+            None
+        } else {
+            self.jettisoned()
+        }
+    }
+
     /// The mesh without the nodes that no tet uses (duplicates of other points, points
     /// outside the domain or in holes), renumbered in order, as TetGen writes its output
     /// unless given `-J`; `None` if every node is used, or if there are no tets.
@@ -161,6 +171,14 @@ mod tests {
         assert!(m.jettisoned().is_none());
         m.tets.clear();
         assert!(m.jettisoned().is_none());
+    }
+
+    #[test]
+    fn the_written_mesh_keeps_unused_nodes_only_with_keep_unused() {
+        let m = with_unused();
+        assert!(m.written(true).is_none());
+        let (w, j) = (m.written(false).unwrap(), m.jettisoned().unwrap());
+        assert_eq!((w.points, w.tets), (j.points, j.tets));
     }
 
     #[test]

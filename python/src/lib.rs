@@ -266,10 +266,7 @@ fn mesh<'py>(py: Python<'py>, plc: &Plc, switches: &str) -> PyResult<Bound<'py, 
         stats,
         warnings,
     } = meshed;
-    let mut out = match (opts.keep_unused, mesh.jettisoned()) {
-        (false, Some(j)) => j,
-        _ => mesh,
-    };
+    let mut out = mesh.written(opts.keep_unused).unwrap_or(mesh);
     let d = PyDict::new(py);
     let points = std::mem::take(&mut out.points);
     let n = points.len();

@@ -177,11 +177,7 @@ pub fn run_model(
     // As TetGen (without -J): the output leaves out the points no tet uses and numbers
     // the rest in order; the library's mesh keeps input point i at node i, which the
     // check below relies on.
-    let jettisoned = if opts.keep_unused {
-        None
-    } else {
-        meshed.mesh.jettisoned()
-    };
+    let jettisoned = meshed.mesh.written(opts.keep_unused);
     let written = jettisoned.as_ref().unwrap_or(&meshed.mesh);
     let unused = meshed.mesh.points.len() - written.points.len();
     if unused > 0 && opts.verbose > 0 {
