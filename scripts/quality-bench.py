@@ -8,10 +8,12 @@ smallest dihedral angle, and the referee's verdict on our mesh. TetGen runs with
 (without it, its optimisation moves the mesh off the constrained Delaunay one).
 
 With --plot FILE it draws the dihedral-angle histograms, ours beside TetGen's, one
-panel per model (matplotlib).
+panel per model (matplotlib). --timeout S counts a run over S seconds as failed;
+--no-referee skips the referee (slow on large meshes). A last line per switch set sums
+points, seconds and bad tets over the models both programs finish. Needs numpy.
 
 usage: scripts/quality-bench.py [--switches -pq1.414 ...] [--repeat N] [--plot FILE]
-                                MODEL...
+                                [--timeout S] [--no-referee] MODEL...
 """
 import argparse
 import math
@@ -43,54 +45,48 @@ def read_mesh(prefix):
     return pts, tets
 
 
-def sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def shape(p):
-    """Radius-edge ratio and the six dihedral angles (degrees) of tet p."""
-    b, c, d = sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0])
-    den = 2 * dot(b, cross(c, d))
-    edges = [math.dist(p[i], p[j]) for i in range(4) for j in range(i + 1, 4)]
-    if den == 0:
-        ratio = math.inf
-    else:
-        cd, db, bc = cross(c, d), cross(d, b), cross(b, c)
-        o = [(dot(b, b) * cd[k] + dot(c, c) * db[k] + dot(d, d) * bc[k]) / den for k in range(3)]
-        ratio = math.sqrt(dot(o, o)) / min(edges)
-    normals = []
-    for k in range(4):
-        f = [i for i in range(4) if i != k]
-        n = cross(sub(p[f[1]], p[f[0]]), sub(p[f[2]], p[f[0]]))
-        if dot(n, sub(p[k], p[f[0]])) > 0:
-            n = (-n[0], -n[1], -n[2])
-        normals.append(n)
+def shapes(pts, tets):
+    """Radius-edge ratios (m,) and dihedral angles in degrees (m, 6) of the tets."""
+    import numpy as np
+    p = np.asarray(pts, dtype=float)[np.asarray(tets, dtype=np.int64).reshape(-1, 4)]
+    a = p[:, 0]
+    b, c, d = p[:, 1] - a, p[:, 2] - a, p[:, 3] - a
+    cd, db, bc = np.cross(c, d), np.cross(d, b), np.cross(b, c)
+    den = 2 * np.einsum("ij,ij->i", b, cd)
+    num = (np.einsum("ij,ij->i", b, b)[:, None] * cd + np.einsum("ij,ij->i", c, c)[:, None] * db
+           + np.einsum("ij,ij->i", d, d)[:, None] * bc)
+    pairs = [(i, j) for i in range(4) for j in range(i + 1, 4)]
+    edges = np.stack([np.linalg.norm(p[:, i] - p[:, j], axis=1) for i, j in pairs], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radius = np.linalg.norm(num / den[:, None], axis=1)
+        ratio = np.where(den == 0, np.inf, radius / edges.min(axis=1))
     angles = []
-    for i in range(4):
-        for j in range(i + 1, 4):
-            k, l = [x for x in range(4) if x not in (i, j)]
-            nn = math.sqrt(dot(normals[k], normals[k]) * dot(normals[l], normals[l]))
-            cos = -dot(normals[k], normals[l]) / nn if nn > 0 else 1.0
-            angles.append(math.degrees(math.acos(max(-1.0, min(1.0, cos)))))
-    return ratio, angles
+    for i, j in pairs:
+        k, l = [x for x in range(4) if x not in (i, j)]
+        e = p[:, j] - p[:, i]
+        e = e / np.linalg.norm(e, axis=1)[:, None]
+        u = p[:, k] - p[:, i]
+        v = p[:, l] - p[:, i]
+        u = u - np.einsum("ij,ij->i", u, e)[:, None] * e
+        v = v - np.einsum("ij,ij->i", v, e)[:, None] * e
+        nn = np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cos = np.where(nn > 0, np.einsum("ij,ij->i", u, v) / nn, 1.0)
+        angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return ratio, np.stack(angles, axis=1)
 
 
-def run(cmd, repeat):
+def run(cmd, repeat, timeout):
     best = math.inf
     for _ in range(repeat):
         t = time.perf_counter()
-        r = subprocess.run(cmd, capture_output=True, text=True)
+        try:
+            r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return None, f"over {timeout:g} s"
         best = min(best, time.perf_counter() - t)
         if r.returncode != 0:
-            return None, r.returncode
+            return None, f"exit {r.returncode}"
     return best, 0
 
 
@@ -114,10 +110,16 @@ def main():
     ap.add_argument("--switches", nargs="+", default=["-pq1.414", "-pq1.414/10"])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--plot")
+    ap.add_argument("--timeout", type=float, default=None,
+                    help="seconds a run may take (reported as a failure past it)")
+    ap.add_argument("--no-referee", action="store_true",
+                    help="do not judge our meshes (the referee is slow on large ones)")
     args = ap.parse_args()
     if not shutil.which("tetgen"):
         sys.exit("tetgen is not installed (apt-get install -y tetgen)")
     hist = {}
+    totals = {}
+    failed = {}
     print("| model | switches | points ours / TetGen | seconds ours / TetGen (ratio) "
           "| bad tets ours / TetGen | smallest dihedral ours / TetGen | referee |")
     print("|---|---|---|---|---|---|---|")
@@ -135,19 +137,18 @@ def main():
                     shutil.copy(model, m)
                     cmd = ([TETCDT, sw + "Q", m] if who == "ours"
                            else ["tetgen", sw + "O0Q", m])
-                    secs, code = run(cmd, args.repeat)
+                    secs, code = run(cmd, args.repeat, args.timeout)
                     if secs is None:
-                        figs[who] = (f"exit {code}", "", "", "", None)
+                        figs[who] = (code, "", "", "", "")
                         continue
                     pts, tets = read_mesh(os.path.join(d, stem + ".1"))
-                    bad, small, angles = 0, 180.0, []
-                    for t in tets:
-                        r, a = shape([pts[v] for v in t])
-                        angles.extend(a)
-                        small = min(small, min(a))
-                        bad += r > ratio or min(a) < angle
+                    ratios, dihedral = shapes(pts, tets)
+                    smallest = dihedral.min(axis=1)
+                    bad = int(((ratios > ratio) | (smallest < angle)).sum())
+                    small = float(smallest.min()) if len(tets) else 180.0
+                    angles = dihedral.ravel()
                     verdict = ""
-                    if who == "ours" and os.path.exists(REFEREE):
+                    if who == "ours" and os.path.exists(REFEREE) and not args.no_referee:
                         out = subprocess.run([sys.executable, REFEREE, m, os.path.join(d, stem + ".1")],
                                              capture_output=True, text=True).stdout.strip()
                         verdict = out.splitlines()[-1] if out else "?"
@@ -160,6 +161,24 @@ def main():
                          if isinstance(o[3], float) and isinstance(t[3], float) else "")
                 print(f"| {name} | {sw} | {o[0]} / {t[0]} | {speed} | {o[2]} / {t[2]} | {small} | {o[4]} |",
                       flush=True)
+                if isinstance(o[1], float) and isinstance(t[1], float):
+                    tot = totals.setdefault(sw, [0, 0, 0.0, 0.0, 0, 0, 0])
+                    tot[0] += o[0]
+                    tot[1] += t[0]
+                    tot[2] += o[1]
+                    tot[3] += t[1]
+                    tot[4] += o[2]
+                    tot[5] += t[2]
+                    tot[6] += 1
+                fails = failed.setdefault(sw, [0, 0])
+                fails[0] += not isinstance(o[1], float)
+                fails[1] += not isinstance(t[1], float)
+    for sw, tot in totals.items():
+        f = failed[sw]
+        print(f"\n{sw}: {tot[6]} models both finish; points {tot[0]} / {tot[1]} "
+              f"({tot[0] / max(tot[1], 1):.2f}); seconds {tot[2]:.2f} / {tot[3]:.2f} "
+              f"({tot[2] / max(tot[3], 1e-9):.2f}); bad tets {tot[4]} / {tot[5]}; "
+              f"failed or over time: ours {f[0]}, TetGen {f[1]}")
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
