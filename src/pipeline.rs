@@ -241,18 +241,11 @@ pub fn mesh_plc_with_progress(
     } = constructed;
     let prep = split.as_ref().unwrap_or(&base);
     let mesh = crate::carve::carve(plc, prep, *built, opts, &mut stats, progress)?;
-    // The mesh is judged on the facets as merged, but with the convex hull kept: then
-    // the groups kept apart are judged as the separate facets they were meshed as (the
-    // flat tets kept outside a bent group lie within its slab).
-    let prepared = match (opts.keep_hull, split) {
-        (true, Some(split)) => split,
-        _ => base,
-    };
     Ok(PlcMesh {
         mesh,
         stats,
         warnings,
-        prepared,
+        prepared: base,
     })
 }
 

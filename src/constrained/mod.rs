@@ -651,17 +651,8 @@ fn prepare_beside_delaunay(
             } else {
                 Some(prepare(plc, true)?)
             };
-            // With the convex hull kept, a group that is not exactly flat is kept apart
-            // too: flat tets outside it, within its slab, are kept with the exterior, and
-            // would lie on it as a second cover (carving removes them otherwise).
             let keep_apart = if opts.merge {
-                let mut apart = prepare::unflat_groups(plc, &base);
-                if opts.keep_hull {
-                    apart.extend(prepare::bent_groups(plc, &base));
-                    apart.sort_unstable();
-                    apart.dedup();
-                }
-                apart
+                prepare::unflat_groups(plc, &base)
             } else {
                 Vec::new()
             };

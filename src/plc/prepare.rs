@@ -124,39 +124,6 @@ impl Dsu {
     }
 }
 
-/// The input facets of the merged groups of `prep` (prepared from `plc`) whose vertices
-/// are not exactly coplanar (exact orientation tests): with the convex hull kept (`-c`)
-/// they are kept apart ([`prepare_except`]; see `constrained::prepare_beside_delaunay`).
-pub fn bent_groups(plc: &Plc, prep: &PreparedPlc) -> Vec<usize> {
-    let pts = &plc.points;
-    let mut out = Vec::new();
-    for f in prep.facets.iter().filter(|f| f.source_facets.len() > 1) {
-        let mut verts: Vec<u32> = f.rings.iter().flatten().copied().collect();
-        verts.extend(f.inner_segments.iter().flatten());
-        verts.extend(&f.isolated);
-        let p = |v: u32| &pts[v as usize];
-        // Three vertices that span the plane: the first, a second apart from it, and a
-        // third off their line.
-        let Some(&a) = verts.first() else { continue };
-        let Some(&b) = verts.iter().find(|&&v| p(v) != p(a)) else {
-            continue;
-        };
-        let Some(&c) = verts
-            .iter()
-            .find(|&&v| !crate::geom::polygon::all_collinear(pts, &[a, b, v]))
-        else {
-            continue;
-        };
-        let flat = verts
-            .iter()
-            .all(|&d| crate::geom::orient3d(p(a), p(b), p(c), p(d)) == 0.0);
-        if !flat {
-            out.extend(&f.source_facets);
-        }
-    }
-    out
-}
-
 /// The input facets of the merged groups of `prep` (prepared from `plc`) that cannot be
 /// triangulated in one plane: their polygons, bent, overlap in its projection or cross
 /// their segments there. They are to be kept apart ([`prepare_except`]).
@@ -600,21 +567,6 @@ mod tests {
         assert_eq!(q.facets.len(), 7);
         assert_eq!(q.segments.len(), 13);
         assert!(q.segments.contains(&[4, 7]));
-    }
-
-    #[test]
-    fn bent_groups_are_the_merged_groups_off_their_plane() {
-        // Two triangles bent by 0.05°: merged, and not exactly flat.
-        let bent = hinge(0.05);
-        let p = prepare(&bent, true).unwrap();
-        assert_eq!(p.facets.len(), 1);
-        assert_eq!(bent_groups(&bent, &p), vec![0, 1]);
-        // The same pair in one plane: merged and flat.
-        let mut flat = bent.clone();
-        flat.points[3] = [0.5, -1.0, 0.0];
-        let q = prepare(&flat, true).unwrap();
-        assert_eq!(q.facets.len(), 1);
-        assert!(bent_groups(&flat, &q).is_empty());
     }
 
     /// Two triangles sharing edge 0–1 with a dihedral angle of 180° − `dev` degrees.
