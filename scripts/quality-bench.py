@@ -119,7 +119,6 @@ def main():
         sys.exit("tetgen is not installed (apt-get install -y tetgen)")
     hist = {}
     totals = {}
-    failed = {}
     print("| model | switches | points ours / TetGen | seconds ours / TetGen (ratio) "
           "| bad tets ours / TetGen | smallest dihedral ours / TetGen | referee |")
     print("|---|---|---|---|---|---|---|")
@@ -155,30 +154,31 @@ def main():
                     figs[who] = (len(pts), secs, bad, small, verdict)
                     hist[(name, sw, who)] = angles
                 o, t = figs["ours"], figs["tetgen"]
-                speed = (f"{o[1]:.3f} / {t[1]:.3f} ({o[1] / t[1]:.2f})"
-                         if isinstance(o[1], float) and isinstance(t[1], float) else f"{o[1]} / {t[1]}")
+                secs = [f"{x[1]:.3f}" if isinstance(x[1], float) else x[1] for x in (o, t)]
+                speed = (f"{secs[0]} / {secs[1]} ({o[1] / t[1]:.2f})"
+                         if isinstance(o[1], float) and isinstance(t[1], float)
+                         else f"{secs[0]} / {secs[1]}")
                 small = (f"{o[3]:.2f} / {t[3]:.2f}"
                          if isinstance(o[3], float) and isinstance(t[3], float) else "")
                 print(f"| {name} | {sw} | {o[0]} / {t[0]} | {speed} | {o[2]} / {t[2]} | {small} | {o[4]} |",
                       flush=True)
-                if isinstance(o[1], float) and isinstance(t[1], float):
-                    tot = totals.setdefault(sw, [0, 0, 0.0, 0.0, 0, 0, 0])
-                    tot[0] += o[0]
-                    tot[1] += t[0]
-                    tot[2] += o[1]
-                    tot[3] += t[1]
-                    tot[4] += o[2]
-                    tot[5] += t[2]
-                    tot[6] += 1
-                fails = failed.setdefault(sw, [0, 0])
-                fails[0] += not isinstance(o[1], float)
-                fails[1] += not isinstance(t[1], float)
+                both = isinstance(o[1], float) and isinstance(t[1], float)
+                tot = totals.setdefault(sw, {"models": 0, "points": [0, 0], "secs": [0.0, 0.0],
+                                             "bad": [0, 0], "failed": [0, 0]})
+                for k, fig in enumerate((o, t)):
+                    tot["failed"][k] += not isinstance(fig[1], float)
+                    if both:
+                        tot["points"][k] += fig[0]
+                        tot["secs"][k] += fig[1]
+                        tot["bad"][k] += fig[2]
+                tot["models"] += both
     for sw, tot in totals.items():
-        f = failed[sw]
-        print(f"\n{sw}: {tot[6]} models both finish; points {tot[0]} / {tot[1]} "
-              f"({tot[0] / max(tot[1], 1):.2f}); seconds {tot[2]:.2f} / {tot[3]:.2f} "
-              f"({tot[2] / max(tot[3], 1e-9):.2f}); bad tets {tot[4]} / {tot[5]}; "
-              f"failed or over time: ours {f[0]}, TetGen {f[1]}")
+        (po, pt), (so, st), (bo, bt), (fo, ft) = (tot["points"], tot["secs"], tot["bad"],
+                                                  tot["failed"])
+        print(f"\n{sw}: {tot['models']} models both finish; points {po} / {pt} "
+              f"({po / max(pt, 1):.2f}); seconds {so:.2f} / {st:.2f} "
+              f"({so / max(st, 1e-9):.2f}); bad tets {bo} / {bt}; "
+              f"failed or over time: ours {fo}, TetGen {ft}")
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")

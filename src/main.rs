@@ -56,8 +56,9 @@ Several FILEs are meshed in parallel (--jobs N, default: the number of cores), e
 with its own outputs; each model's messages are printed whole when it is done, errors
 prefixed with its name, then a summary table (model, status, vertices, Steiner points,
 tets, seconds; with -q, -a or -V also the worst radius-edge ratio, the smallest dihedral
-angle and the tets refinement left) on stdout, also with -Q. --summary FILE writes it as TSV (also for one
-input); --stats-json FILE writes one JSON line per model. -o needs a single FILE.
+angle and the tets refinement left) on stdout, also with -Q. --summary FILE writes it
+as TSV (also for one input); --stats-json FILE writes one JSON line per model. -o needs
+a single FILE.
 Progress bars appear on stderr when it is a terminal and a run takes over a second
 (never with -Q or when CI is set).
 
