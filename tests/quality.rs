@@ -386,3 +386,14 @@ fn refinement_keeps_every_vertex_of_the_domain() {
         }
     }
 }
+
+#[test]
+fn refinement_beside_facets_that_are_not_flat_leaves_no_shim() {
+    // mpi.off merges polygons 0.1° apart into facets far from flat: split points on
+    // the segments of one lie within the slab of its neighbour, and circumcentres fall
+    // just off it. Each insertion is taken back when it would leave a tet of the domain
+    // flat on one facet, or a face covering a facet twice; the run must be certified.
+    let r = refine(&example("nonflat/mpi.off"), "-pq1.414");
+    assert!(r.points.len() > 90, "refinement added no point");
+    assert!(!r.tets.is_empty());
+}

@@ -821,7 +821,7 @@ impl<'a> Construction<'a> {
             let covering = self
                 .free_in_place
                 .iter()
-                .any(|&v| search.covering_face_around(&self.cdt, v, false));
+                .any(|&v| search.covering_face_around(&self.cdt, v, false, |_| true));
             if covering {
                 if debug() {
                     eprintln!(
@@ -887,7 +887,7 @@ impl<'a> Construction<'a> {
                 let search = self
                     .search
                     .get_or_insert_with(|| flat_tet_search(plc, merged, opts));
-                v.is_some_and(|v| search.covering_face_around(&self.cdt, v, true))
+                v.is_some_and(|v| search.covering_face_around(&self.cdt, v, true, |_| true))
             }
             _ => false,
         };
@@ -956,6 +956,7 @@ fn flat_tet_search<'a>(
             keep_hull: opts.keep_hull,
         },
         index: Default::default(),
+        shared: None,
     }
 }
 

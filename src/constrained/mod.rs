@@ -20,7 +20,7 @@ mod flip_queue;
 pub(crate) mod free;
 mod in_place;
 pub mod segments;
-mod slivers;
+pub(crate) mod slivers;
 
 pub(crate) use construction::regions_of;
 

@@ -57,8 +57,11 @@ pub(crate) struct Search<'a> {
     pub input: &'a [Point],
     pub domain: DomainOf<'a>,
     /// Which facets each input vertex is on, and the facets' slabs: made when first
-    /// needed (a model without Steiner points never needs them).
+    /// needed (a model without Steiner points never needs them), unless `shared` gives
+    /// them.
     pub index: OnceCell<FacetIndex>,
+    /// The index made by the caller, who keeps it across searches.
+    pub shared: Option<&'a FacetIndex>,
 }
 
 /// Which facets each input vertex is on, and the facets' slabs.
@@ -70,38 +73,105 @@ pub(crate) struct FacetIndex {
     /// Each facet's slab as a box (empty without a slab), and a hierarchy over them.
     boxes: Vec<Aabb>,
     bvh: Bvh,
+    /// Vertices with input indices below this are input vertices.
+    n_input: usize,
+}
+
+impl FacetIndex {
+    /// The index of `prep`'s facets over the points `input`, of which the first
+    /// `n_input` are input vertices (the others, such as corners of polygons added to a
+    /// live CDT, count as Steiner points: on a facet when its slab holds them).
+    pub(crate) fn new(prep: &PreparedPlc, input: &[Point], n_input: usize) -> FacetIndex {
+        let diag = diagonal(input);
+        let slabs: Vec<Option<Slab>> = (0..prep.facets.len())
+            .map(|fi| slab_of(prep, input, diag, fi))
+            .collect();
+        let boxes: Vec<Aabb> = slabs
+            .iter()
+            .map(|s| match s {
+                Some(s) => [s.lo.map(|x| x - s.tol), s.hi.map(|x| x + s.tol)],
+                None => [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]],
+            })
+            .collect();
+        FacetIndex {
+            bvh: Bvh::build(&boxes),
+            boxes,
+            on_facets: crate::mesh::VertexLists::new(
+                input.len(),
+                prep.facets
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| f.normal != [0.0; 3])
+                    .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
+            ),
+            tol_max: slabs.iter().flatten().map(|s| s.tol).fold(0.0, f64::max),
+            slabs,
+            n_input,
+        }
+    }
+
+    /// The facet of which the tet with points `p` and input indices `o` would be a
+    /// shim: flat, with all four vertices on that facet (see [`Self::facet_holding`]).
+    pub(crate) fn shim_facet(&self, p: &[Point; 4], o: [u32; 4]) -> Option<u32> {
+        if !may_lie_in_slab(p, self.tol_max) || !is_flat(p) {
+            return None;
+        }
+        self.facet_holding(p, o)
+    }
+
+    /// The facet that the tet with points `p` whose input indices are `o` (Steiner
+    /// points have indices past the input's) has all four vertices on, if any: input
+    /// vertices by the facets' rings, Steiner points by the facets' slabs. The lowest
+    /// such facet is named.
+    fn facet_holding(&self, p: &[Point; 4], o: [u32; 4]) -> Option<u32> {
+        let on = |i: usize, f: u32| -> bool {
+            if (o[i] as usize) < self.n_input {
+                self.on_facets.of(o[i]).contains(&f)
+            } else {
+                self.slabs[f as usize]
+                    .as_ref()
+                    .is_some_and(|s| s.holds(&p[i]))
+            }
+        };
+        // With an input vertex, the facets the tet can lie on are among that vertex's
+        // (the shortest such list is tried, in increasing order). Most tets go this way.
+        if let Some(x) = (0..4)
+            .filter(|&i| (o[i] as usize) < self.n_input)
+            .min_by_key(|&i| self.on_facets.of(o[i]).len())
+        {
+            return self
+                .on_facets
+                .of(o[x])
+                .iter()
+                .copied()
+                .find(|&f| (0..4).all(|i| on(i, f)));
+        }
+        // A tet of Steiner points has no input vertex to name its facet: any facet whose
+        // slab holds all four may, even one none of their segments touches (a bent
+        // group's slab can hold the split points of a neighbouring fan). The lowest is
+        // named.
+        let bbox: Aabb = [
+            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::INFINITY, f64::min)),
+            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::NEG_INFINITY, f64::max)),
+        ];
+        let mut best: Option<u32> = None;
+        self.bvh.query(&self.boxes, &bbox, |f| {
+            let f = f as u32;
+            if best.is_none_or(|b| f < b) && (0..4).all(|i| on(i, f)) {
+                best = Some(f);
+            }
+        });
+        best
+    }
 }
 
 impl Search<'_> {
     fn index(&self) -> &FacetIndex {
-        self.index.get_or_init(|| {
-            let diag = diagonal(self.input);
-            let slabs: Vec<Option<Slab>> = (0..self.prep.facets.len())
-                .map(|fi| slab_of(self.prep, self.input, diag, fi))
-                .collect();
-            let boxes: Vec<Aabb> = slabs
-                .iter()
-                .map(|s| match s {
-                    Some(s) => [s.lo.map(|x| x - s.tol), s.hi.map(|x| x + s.tol)],
-                    None => [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]],
-                })
-                .collect();
-            FacetIndex {
-                bvh: Bvh::build(&boxes),
-                boxes,
-                on_facets: crate::mesh::VertexLists::new(
-                    self.input.len(),
-                    self.prep
-                        .facets
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, f)| f.normal != [0.0; 3])
-                        .flat_map(|(fi, f)| ring_verts(f).into_iter().map(move |v| (v, fi as u32))),
-                ),
-                tol_max: slabs.iter().flatten().map(|s| s.tol).fold(0.0, f64::max),
-                slabs,
-            }
-        })
+        if let Some(index) = self.shared {
+            return index;
+        }
+        self.index
+            .get_or_init(|| FacetIndex::new(self.prep, self.input, self.input.len()))
     }
 
     /// Facet `fi`'s slab, if it has one.
@@ -125,54 +195,24 @@ impl Search<'_> {
         )
     }
 
-    /// [`Self::facet_of`] for points `p` whose input indices are `o` (Steiner points have
-    /// indices past the input's).
+    /// [`FacetIndex::facet_holding`].
     fn facet_holding(&self, p: &[Point; 4], o: [u32; 4]) -> Option<u32> {
-        let n_input = self.input.len();
-        let index = self.index();
-        let on = |i: usize, f: u32| -> bool {
-            if (o[i] as usize) < n_input {
-                index.on_facets.of(o[i]).contains(&f)
-            } else {
-                self.slab(f as usize).is_some_and(|s| s.holds(&p[i]))
-            }
-        };
-        // With an input vertex, the facets the tet can lie on are among that vertex's
-        // (the shortest such list is tried, in increasing order). Most tets go this way.
-        if let Some(x) = (0..4)
-            .filter(|&i| (o[i] as usize) < n_input)
-            .min_by_key(|&i| index.on_facets.of(o[i]).len())
-        {
-            return index
-                .on_facets
-                .of(o[x])
-                .iter()
-                .copied()
-                .find(|&f| (0..4).all(|i| on(i, f)));
-        }
-        // A tet of Steiner points has no input vertex to name its facet: any facet whose
-        // slab holds all four may, even one none of their segments touches (a bent
-        // group's slab can hold the split points of a neighbouring fan). The lowest is
-        // named.
-        let bbox: Aabb = [
-            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::INFINITY, f64::min)),
-            std::array::from_fn(|k| p.iter().map(|q| q[k]).fold(f64::NEG_INFINITY, f64::max)),
-        ];
-        let mut best: Option<u32> = None;
-        index.bvh.query(&index.boxes, &bbox, |f| {
-            let f = f as u32;
-            if best.is_none_or(|b| f < b) && (0..4).all(|i| on(i, f)) {
-                best = Some(f);
-            }
-        });
-        best
+        self.index().facet_holding(p, o)
     }
 
     /// Whether the faces around vertex `v` (through it, or else opposite it in its tets)
     /// that are not subfaces but have their three vertices on one facet cover more than a
     /// trace of it (projected on the facet's normal, together over a millionth of its
     /// area, the referee's tolerance): they would lie on the facet beside its triangles.
-    pub(crate) fn covering_face_around(&self, cdt: &Cdt, v: VertexId, through: bool) -> bool {
+    /// Only the faces of tets that `kept` accepts count (asked only for faces on a
+    /// facet: the test may be costly).
+    pub(crate) fn covering_face_around(
+        &self,
+        cdt: &Cdt,
+        v: VertexId,
+        through: bool,
+        kept: impl Fn(crate::mesh::TetId) -> bool,
+    ) -> bool {
         let mut star = Vec::new();
         cdt.dt.star(v, &mut star);
         let mut covered: Vec<(u32, f64)> = Vec::new();
@@ -190,7 +230,7 @@ impl Search<'_> {
                     continue;
                 };
                 let q = f.map(|x| cdt.dt.points[x as usize]);
-                if !self.face_inside_facet(fi as usize, &q) {
+                if !self.face_inside_facet(fi as usize, &q) || !kept(t) {
                     continue;
                 }
                 let n = cross(&sub(&q[1], &q[0]), &sub(&q[2], &q[0]));
@@ -874,6 +914,7 @@ mod tests {
                 keep_hull: false,
             },
             index: Default::default(),
+            shared: None,
         };
         let tri = |x: f64, y: f64, z: f64| [[x, y, z], [x + 0.2, y, z], [x, y + 0.2, z]];
         let facet = |z: f64| {
@@ -930,6 +971,7 @@ mod tests {
                 keep_hull: false,
             },
             index: Default::default(),
+            shared: None,
         };
         let top = prep
             .facets

@@ -94,6 +94,9 @@ pub struct Cdt {
     /// The PLC with the polygons inserted since (their vertices appended as points),
     /// which certification judges against, and its preparation.
     judged: (Plc, PreparedPlc),
+    /// The judged facets' slabs and which facets each input vertex is on, for the shim
+    /// test after each insertion: made when first needed, again after a polygon goes in.
+    facet_index: std::cell::OnceCell<crate::constrained::slivers::FacetIndex>,
     /// Vertices treated as input vertices when a subsegment is split: those of the PLC,
     /// and the corners of inserted polygons (the power-of-two shells protect the angles
     /// at both).
@@ -145,6 +148,7 @@ impl Cdt {
             opts: opts.clone(),
             meshed: c.split.unwrap_or_else(|| c.base.clone()),
             judged: (plc.clone(), c.base),
+            facet_index: Default::default(),
             corners: Default::default(),
             split_log: None,
             near: 1e-10 * crate::geom::diagonal(&plc.points),
@@ -313,6 +317,10 @@ impl Cdt {
         let inserted = free::insert_point(&mut self.tets, p, self.next_pert, true)
             .map_err(|_| InsertError::Refused(p))?;
         match inserted {
+            free::Inserted::Yes { vertex, .. } if self.breaks_facets(vertex) => {
+                free::take_back(&mut self.tets, inserted);
+                Err(InsertError::Refused(p))
+            }
             free::Inserted::Yes { vertex, .. } => {
                 self.next_pert += 1;
                 self.added += 1;

@@ -122,6 +122,7 @@ impl Cdt {
             return Err(PolygonError::Invalid(e.to_string()));
         }
         self.judged = judged;
+        self.facet_index = Default::default();
         let subfaces = self.tets.subfaces.values().filter(|&&f| f == fi).count();
         Ok(PolygonInserted {
             corners: corners

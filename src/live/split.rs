@@ -6,6 +6,7 @@
 use super::{Cdt, InsertError, Tets};
 use crate::constrained::cdt::{edge_key, face_key};
 use crate::constrained::free;
+use crate::constrained::slivers::{DomainOf, FacetIndex, Search};
 use crate::delaunay::Walled;
 use crate::geom::encroach::{
     circumcenter, in_diametral_ball, in_equatorial_ball, near_segment, near_triangle,
@@ -584,7 +585,8 @@ impl Cdt {
         };
         let ok = matches!(settled, free::Inserted::Yes { .. })
             && made.iter().all(|s| self.tets.has_face(s[0], s[1], s[2]))
-            && !self.makes_shim(vertex, facets);
+            && !self.makes_shim(vertex, facets)
+            && !self.breaks_facets(vertex);
         if !ok {
             free::take_back(&mut self.tets, settled);
             undo_tables(&mut self.tets);
@@ -640,6 +642,56 @@ impl Cdt {
                 })
                 && !self.reaches_hull(t)
         })
+    }
+
+    /// Whether the tets around `v` break a facet as the certifier and the referee see
+    /// it, a Steiner point counting as on every facet whose slab holds it: a tet inside
+    /// the domain that is a shim (flat, with all four vertices on one facet), or a face
+    /// through or opposite `v` that is no subface yet lies on a facet, covering it twice.
+    /// A point within the slab of a facet that is not flat, beside it (on a segment of a
+    /// nearly coplanar neighbour, or a circumcentre just off it), makes these with the
+    /// facet's vertices though no facet it lies on is split.
+    pub(super) fn breaks_facets(&self, v: VertexId) -> bool {
+        let (plc, prep) = &self.judged;
+        let index = self
+            .facet_index
+            .get_or_init(|| FacetIndex::new(prep, &plc.points, self.plc.points.len()));
+        let search = Search {
+            prep,
+            input: &plc.points,
+            domain: DomainOf {
+                holes: &plc.holes,
+                regions: &plc.regions,
+                keep_hull: self.opts.keep_hull,
+            },
+            index: Default::default(),
+            shared: Some(index),
+        };
+        // Faces of the exterior (a layer of flat tets between a facet that is not flat
+        // and the hull) are carved away with it.
+        let inside = |t: TetId| !self.reaches_hull(t);
+        if search.covering_face_around(&self.tets, v, true, inside)
+            || search.covering_face_around(&self.tets, v, false, inside)
+        {
+            return true;
+        }
+        let mut star = Vec::new();
+        self.tets.dt.star(v, &mut star);
+        let dt = &self.tets.dt;
+        let shims: Vec<TetId> = star
+            .into_iter()
+            .filter(|&t| {
+                let w = dt.mesh.verts(t);
+                !w.contains(&GHOST)
+                    && index
+                        .shim_facet(
+                            &w.map(|x| dt.points[x as usize]),
+                            w.map(|x| dt.orig[x as usize]),
+                        )
+                        .is_some()
+            })
+            .collect();
+        shims.into_iter().any(|t| !self.reaches_hull(t))
     }
 
     /// Whether tet `t` reaches the hull through faces that are no subfaces, within
