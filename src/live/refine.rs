@@ -328,6 +328,9 @@ impl Cdt {
                 face_circumcenter(&a, &b, &c)
             }
         };
+        if self.was_refused(&m) {
+            return Err(InsertError::Refused(m));
+        }
         if self.insertion_radius(&m) < need {
             return Ok(None);
         }

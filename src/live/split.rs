@@ -158,6 +158,21 @@ impl Cdt {
     /// its own, and a subface's circumcentre that does is dropped for it (Shewchuk's
     /// rule). The number of points added.
     fn run_splits(&mut self, first: Target) -> Result<usize, InsertError> {
+        let at = self.split_point(first);
+        let r = self.run_split_stack(first);
+        // A refused cascade is refused again from its start: the splits it needs wait on
+        // each other (a subface in the way of a subsegment's split, whose split point
+        // encroaches upon that subsegment), and many bad tets lead to the same start.
+        if let (Err(InsertError::Refused(_)), Some(m), Some(set)) =
+            (&r, at, &mut self.refused_splits)
+        {
+            set.insert(m.map(f64::to_bits));
+        }
+        r
+    }
+
+    /// [`Cdt::run_splits`] without remembering its refusal.
+    fn run_split_stack(&mut self, first: Target) -> Result<usize, InsertError> {
         if self.keep_boundary {
             let at = self.split_point(first).unwrap_or([f64::NAN; 3]);
             return Err(InsertError::BoundaryKept(at));
@@ -178,6 +193,11 @@ impl Cdt {
                 stack.pop();
                 continue;
             };
+            // A point refused before is refused again at once, before its walled
+            // cavity is sought (many bad tets lead to the same split).
+            if self.was_refused(&m) {
+                return Err(InsertError::Refused(m));
+            }
             let skip = match top {
                 Target::Edge(a, b, _) => Some(edge_key(a, b)),
                 Target::Face(..) => None,
@@ -206,11 +226,7 @@ impl Cdt {
                     Target::Face(..) => return Err(InsertError::Refused(m)),
                 };
             }
-            if self
-                .refused_splits
-                .as_ref()
-                .is_some_and(|r| r.contains(&m.map(f64::to_bits)))
-            {
+            if self.was_refused(&m) {
                 return Err(InsertError::Refused(m));
             }
             let in_way = match top {
@@ -236,6 +252,14 @@ impl Cdt {
             made += 1;
         }
         Ok(made)
+    }
+
+    /// Whether split point `m` was refused while refusals are remembered
+    /// ([`Cdt::refused_splits`]).
+    pub(super) fn was_refused(&self, m: &Point) -> bool {
+        self.refused_splits
+            .as_ref()
+            .is_some_and(|r| r.contains(&m.map(f64::to_bits)))
     }
 
     /// Runs split `f` at `m`, and remembers `m` if the CDT refuses it while refusals
