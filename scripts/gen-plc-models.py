@@ -61,6 +61,9 @@ CORPUS_COPIES = [
     # Facets meeting at a 0.0012 step: valid only with a point found by another
     # construction (retries for thick tets on facets, src/constrained/mod.rs).
     "tetgentests_cgal/mpi.off",
+    # Refinement once split its facet x = -0.5 ever finer around one point, far below
+    # the insertion floor (tests/quality.rs).
+    "tetgentests_cgal/handle.off",
 ]
 
 

@@ -397,3 +397,25 @@ fn refinement_beside_facets_that_are_not_flat_leaves_no_shim() {
     assert!(r.points.len() > 90, "refinement added no point");
     assert!(!r.tets.is_empty());
 }
+
+#[test]
+fn refinement_ends_where_splits_cascade_toward_a_point() {
+    // Splits that other splits ask for once ignored the insertion floor: on handle.off
+    // subfaces of its facet x = -0.5 were split ever finer around one point (edges of
+    // 1e-11, the floor about 3e-5) and -pq1.414 did not end in minutes. Every split
+    // point now keeps a fraction of the floor, so refinement ends.
+    let r = refine(&example("plc/handle.off"), "-pq1.414");
+    assert!(r.points.len() > 1165, "refinement added no point");
+    let shortest = r
+        .tets
+        .iter()
+        .flat_map(|t| {
+            let p = t.map(|v| r.points[v]);
+            (0..4).flat_map(move |i| (i + 1..4).map(move |j| (p[i], p[j])))
+        })
+        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt())
+        .fold(f64::INFINITY, f64::min);
+    // The input's shortest edge in its CDT is about 1.1e-4; the floor is a quarter of
+    // it, and a cascade of splits keeps an eighth of the floor.
+    assert!(shortest > 3e-6, "an edge of {shortest}");
+}

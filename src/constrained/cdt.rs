@@ -207,6 +207,23 @@ impl Cdt {
         self.dt.walled_conflict(p, pert, blocked)
     }
 
+    /// [`Cdt::walled_conflict`] with the subfaces that `open` accepts left open: for a
+    /// point on a constraint, its own subfaces, so that its cavity reaches both sides
+    /// whichever side the point is located on.
+    pub fn walled_conflict_open(
+        &mut self,
+        p: crate::geom::Point,
+        pert: u32,
+        open: impl Fn(&[VertexId; 3]) -> bool,
+    ) -> Result<Vec<TetId>, crate::error::MeshError> {
+        let subfaces = &self.subfaces;
+        let blocked = |v: [VertexId; 4], f: usize| {
+            let k = face_key(FACE_VERTS[f].map(|k| v[k]));
+            subfaces.contains_key(&k) && !open(&k)
+        };
+        self.dt.walled_conflict(p, pert, blocked)
+    }
+
     /// Number of live real tets.
     pub fn num_tets(&self) -> usize {
         self.dt.mesh.real_tets().count()

@@ -65,6 +65,15 @@ pub enum InsertError {
     /// configuration the splits do not cover.
     #[error("the point {0:?} fits no cavity of the CDT")]
     Refused(Point),
+    /// While refining: the split would put a point nearer a vertex than the insertion
+    /// floor.
+    #[error("the split point {point:?} would come within {floor} of a vertex")]
+    TooClose {
+        /// The split point.
+        point: Point,
+        /// The insertion floor.
+        floor: f64,
+    },
     /// The point needs a split of a subsegment or subface, and the boundary is kept
     /// (`-Y`).
     #[error("the point {0:?} needs a split of the boundary, which is kept")]
@@ -121,6 +130,8 @@ pub struct Cdt {
     refused_splits: Option<rustc_hash::FxHashSet<[u64; 3]>>,
     /// While refining under `-Y`: no subsegment or subface may be split.
     keep_boundary: bool,
+    /// While refining: no split point may come nearer a vertex than this (0 otherwise).
+    split_floor: f64,
 }
 
 impl Cdt {
@@ -159,6 +170,7 @@ impl Cdt {
             added: 0,
             refused_splits: None,
             keep_boundary: false,
+            split_floor: 0.0,
         }
     }
 

@@ -27,7 +27,7 @@ use crate::constrained::domain::NO_REGION;
 use crate::geom::encroach::circumcenter as face_circumcenter;
 use crate::geom::quality;
 use crate::geom::{norm, orient3d, sub, Point};
-use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS, GHOST};
+use crate::mesh::{FaceRef, TetId, VertexId, FACE_VERTS};
 use rustc_hash::FxHashSet;
 
 /// What refinement aims for.
@@ -108,9 +108,15 @@ impl Cdt {
         let floor = self.insertion_floor(params);
         self.refused_splits = Some(FxHashSet::default());
         self.keep_boundary = params.keep_boundary;
+        // The splits a cascade makes below the first one keep an eighth of the floor:
+        // away from small angles each step of Shewchuk's chain (tet, subface,
+        // subsegment, its shell) shrinks the insertion radius by at most half, so
+        // ordinary cascades stay above it, and a runaway one stops there.
+        self.split_floor = floor / CASCADE_STEPS;
         let result = self.refine_passes(params, floor);
         self.refused_splits = None;
         self.keep_boundary = false;
+        self.split_floor = 0.0;
         result
     }
 
@@ -331,7 +337,11 @@ impl Cdt {
         if self.was_refused(&m) {
             return Err(InsertError::Refused(m));
         }
-        if self.insertion_radius(&m) < need {
+        let on = match e {
+            Encroached::Subsegment(a, b) => super::split::On::Subsegment(a, b),
+            Encroached::Subface(f) => super::split::On::Subface(f),
+        };
+        if self.insertion_radius(&m, on) < need {
             return Ok(None);
         }
         let n = match e {
@@ -391,29 +401,24 @@ impl Cdt {
     /// subsegment first (the one with the lowest key), then a subface.
     fn encroached_by(&mut self, c: &Point) -> Option<Encroached> {
         let pert = self.next_pert;
-        let (seg, face) = super::split::encroached_constraints(&mut self.tets, c, pert, None, true);
-        seg.map(|(a, b)| Encroached::Subsegment(a, b))
-            .or(face.map(Encroached::Subface))
+        let found = super::split::encroached_constraints(&mut self.tets, c, pert, None, true);
+        found
+            .seg
+            .map(|(a, b)| Encroached::Subsegment(a, b))
+            .or(found.face.map(Encroached::Subface))
     }
 
-    /// The distance from `m` to the nearest vertex of its walled cavity: the length of
-    /// the shortest edge its insertion would make.
-    fn insertion_radius(&mut self, m: &Point) -> f64 {
+    /// The distance from split point `m`, on constraint `on`, to the nearest vertex of
+    /// its cavity walled in by the other subfaces (both sides of `on` count): the length
+    /// of the shortest edge its insertion would make.
+    fn insertion_radius(&mut self, m: &Point, on: super::split::On) -> f64 {
         let pert = self.next_pert;
-        let Ok(conflict) = self.tets.walled_conflict(*m, pert) else {
-            return 0.0;
-        };
-        let mut r = f64::INFINITY;
-        for &t in &conflict {
-            for x in self.tets.dt.mesh.verts(t) {
-                if x != GHOST {
-                    r = r.min(norm(&sub(&self.tets.dt.points[x as usize], m)));
-                }
-            }
-        }
-        r
+        super::split::encroached_constraints(&mut self.tets, m, pert, Some(on), false).nearest
     }
 }
+
+/// How much further than the insertion floor a cascade of splits may go: three halvings.
+const CASCADE_STEPS: f64 = 8.0;
 
 /// The vertices of a tet, sorted: its key across passes.
 fn sorted(mut v: [VertexId; 4]) -> [VertexId; 4] {

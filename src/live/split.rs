@@ -11,15 +11,28 @@ use crate::delaunay::Walled;
 use crate::geom::encroach::{
     circumcenter, in_diametral_ball, in_equatorial_ball, near_segment, near_triangle,
 };
-use crate::geom::Point;
+use crate::geom::{norm, sub, Point};
 use crate::mesh::{FaceRef, TetId, VertexId, EDGE_VERTS, FACE_VERTS, GHOST};
 
 /// A constraint that a point lies on exactly.
+#[derive(Clone, Copy)]
 pub(super) enum On {
     /// Strictly inside subsegment `a`–`b`.
     Subsegment(VertexId, VertexId),
     /// Strictly inside this subface.
     Subface([VertexId; 3]),
+}
+
+impl On {
+    /// Whether subface `k` (a sorted key) lies on this constraint: through the
+    /// subsegment, or the subface itself. A cavity of a point on the constraint is open
+    /// through these, so that both sides count whichever side the point is located on.
+    pub(super) fn opens(&self, k: &[VertexId; 3]) -> bool {
+        match *self {
+            On::Subsegment(a, b) => k.contains(&a) && k.contains(&b),
+            On::Subface(f) => *k == face_key(f),
+        }
+    }
 }
 
 /// The constraint of tet `t` (which holds `p`, possibly on its boundary) that `p` lies on,
@@ -45,25 +58,56 @@ pub(super) fn on_constraint(tets: &Tets, t: TetId, p: &Point, tol: f64) -> Optio
     })
 }
 
+/// What the walled cavity of a point shows (see [`encroached_constraints`]).
+pub(super) struct Encroachment {
+    /// A subsegment whose diametral ball holds the point.
+    pub seg: Option<(VertexId, VertexId)>,
+    /// A subface whose equatorial ball holds it.
+    pub face: Option<[VertexId; 3]>,
+    /// The distance to the cavity's nearest vertex: the shortest edge its insertion
+    /// would make (0 if the point is a vertex).
+    pub nearest: f64,
+}
+
 /// A subsegment of the walled cavity of `p` whose diametral ball holds `p`, if any (the
-/// one with the lowest key, so that the choice does not depend on hashing); `skip` is
-/// left out (the subsegment `p` splits). With `faces`, also a subface of it whose
-/// equatorial ball holds `p` (the lowest key).
+/// one with the lowest key, so that the choice does not depend on hashing), and the
+/// distance to the cavity's nearest vertex. `p` lies on constraint `on`, if given: that
+/// subsegment is left out, and the cavity is open through the subfaces on it. With
+/// `faces`, also a subface of it whose equatorial ball holds `p` (the lowest key).
 pub(super) fn encroached_constraints(
     tets: &mut Tets,
     p: &Point,
     pert: u32,
-    skip: Option<(VertexId, VertexId)>,
+    on: Option<On>,
     faces: bool,
-) -> (Option<(VertexId, VertexId)>, Option<[VertexId; 3]>) {
-    let Ok(conflict) = tets.walled_conflict(*p, pert) else {
-        return (None, None);
+) -> Encroachment {
+    // A split point lies on the constraint `on`, which it does not encroach upon.
+    let skip = match on {
+        Some(On::Subsegment(a, b)) => Some(edge_key(a, b)),
+        _ => None,
+    };
+    let open = |k: &[VertexId; 3]| on.is_some_and(|o| o.opens(k));
+    let Ok(conflict) = tets.walled_conflict_open(*p, pert, open) else {
+        return Encroachment {
+            seg: None,
+            face: None,
+            nearest: 0.0,
+        };
     };
     let pt = |x: VertexId| &tets.dt.points[x as usize];
     let mut seg: Option<(VertexId, VertexId)> = None;
     let mut face: Option<[VertexId; 3]> = None;
+    // An empty cavity: the point coincides with a vertex.
+    let mut nearest = if conflict.is_empty() {
+        0.0
+    } else {
+        f64::INFINITY
+    };
     for t in conflict {
         let v = tets.dt.mesh.verts(t);
+        for &x in v.iter().filter(|&&x| x != GHOST) {
+            nearest = nearest.min(norm(&sub(pt(x), p)));
+        }
         for &(i, j) in &EDGE_VERTS {
             let e = edge_key(v[i], v[j]);
             if e.1 == GHOST || Some(e) == skip || !tets.subsegs.contains_key(&e) {
@@ -86,23 +130,13 @@ pub(super) fn encroached_constraints(
             }
         }
     }
-    (seg, face)
-}
-
-/// [`encroached_constraints`], subsegments only.
-fn encroached_except(
-    tets: &mut Tets,
-    p: &Point,
-    pert: u32,
-    skip: Option<(VertexId, VertexId)>,
-) -> Option<(VertexId, VertexId)> {
-    encroached_constraints(tets, p, pert, skip, false).0
+    Encroachment { seg, face, nearest }
 }
 
 /// A subsegment that point `p` encroaches upon, if any (see [`encroached_except`]).
 pub(super) fn encroached(cdt: &mut Cdt, p: &Point) -> Option<(VertexId, VertexId)> {
     let pert = cdt.next_pert;
-    encroached_except(&mut cdt.tets, p, pert, None)
+    encroached_constraints(&mut cdt.tets, p, pert, None, false).seg
 }
 
 /// A split to make: of a subsegment, of an edge of a facet's triangulation (the
@@ -163,7 +197,7 @@ impl Cdt {
         // A refused cascade is refused again from its start: the splits it needs wait on
         // each other (a subface in the way of a subsegment's split, whose split point
         // encroaches upon that subsegment), and many bad tets lead to the same start.
-        if let (Err(InsertError::Refused(_)), Some(m), Some(set)) =
+        if let (Err(InsertError::Refused(_) | InsertError::TooClose { .. }), Some(m), Some(set)) =
             (&r, at, &mut self.refused_splits)
         {
             set.insert(m.map(f64::to_bits));
@@ -198,13 +232,15 @@ impl Cdt {
             if self.was_refused(&m) {
                 return Err(InsertError::Refused(m));
             }
-            let skip = match top {
-                Target::Edge(a, b, _) => Some(edge_key(a, b)),
-                Target::Face(..) => None,
+            let on = match top {
+                Target::Edge(a, b, _) => On::Subsegment(a, b),
+                Target::Face(f, _) => On::Subface(f),
             };
             let pert = self.next_pert;
             let mut m = m;
-            if let Some(e) = encroached_except(&mut self.tets, &m, pert, skip) {
+            let found = encroached_constraints(&mut self.tets, &m, pert, Some(on), false);
+            let mut nearest = found.nearest;
+            if let Some(e) = found.seg {
                 let seg = Target::Edge(e.0, e.1, None);
                 if !stack.contains(&seg) {
                     if let Target::Face(..) = top {
@@ -220,11 +256,28 @@ impl Cdt {
                 // algorithm does, and the other next: each split halves the pieces, and
                 // pieces shorter than the distance between the two encroach upon
                 // nothing. The insertion itself refuses to lose a subsegment.
-                m = match top {
+                let moved = match top {
                     Target::Edge(a, b, None) => self.shell_point_between(a, b, e).unwrap_or(m),
                     Target::Edge(..) => m,
                     Target::Face(..) => return Err(InsertError::Refused(m)),
                 };
+                if moved != m {
+                    m = moved;
+                    nearest =
+                        encroached_constraints(&mut self.tets, &m, pert, Some(on), false).nearest;
+                }
+            }
+            // While refining, no split comes nearer a vertex than the insertion floor,
+            // whatever asked for it (the termination argument, ARCHITECTURE.md).
+            let redirected = match top {
+                Target::Face(f, _) => matches!(self.face_split(f, m), FaceSplit::Edge(..)),
+                Target::Edge(..) => false,
+            };
+            if nearest < self.split_floor && !redirected {
+                return Err(InsertError::TooClose {
+                    point: m,
+                    floor: self.split_floor,
+                });
             }
             if self.was_refused(&m) {
                 return Err(InsertError::Refused(m));
