@@ -333,6 +333,13 @@ impl Cdt {
                 free::take_back(&mut self.tets, inserted);
                 Err(InsertError::Refused(p))
             }
+            free::Inserted::Yes { vertex, .. } if self.too_close(vertex) => {
+                free::take_back(&mut self.tets, inserted);
+                Err(InsertError::TooClose {
+                    point: p,
+                    floor: self.split_floor,
+                })
+            }
             free::Inserted::Yes { vertex, .. } => {
                 self.next_pert += 1;
                 self.added += 1;

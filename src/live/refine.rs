@@ -307,17 +307,22 @@ impl Cdt {
         // to a vertex than that comes from a small input angle (Shewchuk's chain of
         // insertion radii shrinks by at most this factor elsewhere).
         let need = floor.max(0.5 * shortest);
+        // The distance from `c` to the nearest vertex of its walled cavity: the tet's
+        // circumradius where the CDT is Delaunay, less where a vertex hidden behind a
+        // subface lies inside the circumsphere.
+        let mut nearest = norm(&sub(&c, &p[0]));
         let target = match self.walk_toward(t, &c) {
             Walk::Hull => return Ok(None),
             Walk::Wall(f) => Some(Encroached::Subface(face_key(f))),
             Walk::Inside(at) => {
                 self.tets.dt.start_walks_at(at);
-                self.encroached_by(&c)
+                let (e, near) = self.encroached_by(&c);
+                nearest = nearest.min(near);
+                e
             }
         };
         let Some(e) = target else {
-            let radius = norm(&sub(&c, &p[0]));
-            if radius < need {
+            if nearest < need {
                 return Ok(None);
             }
             let before = self.added;
@@ -398,14 +403,16 @@ impl Cdt {
     }
 
     /// The constraint of point `c`'s walled cavity that `c` encroaches upon, if any: a
-    /// subsegment first (the one with the lowest key), then a subface.
-    fn encroached_by(&mut self, c: &Point) -> Option<Encroached> {
+    /// subsegment first (the one with the lowest key), then a subface; and the distance
+    /// from `c` to the cavity's nearest vertex.
+    fn encroached_by(&mut self, c: &Point) -> (Option<Encroached>, f64) {
         let pert = self.next_pert;
         let found = super::split::encroached_constraints(&mut self.tets, c, pert, None, true);
-        found
+        let e = found
             .seg
             .map(|(a, b)| Encroached::Subsegment(a, b))
-            .or(found.face.map(Encroached::Subface))
+            .or(found.face.map(Encroached::Subface));
+        (e, found.nearest)
     }
 
     /// The distance from split point `m`, on constraint `on`, to the nearest vertex of

@@ -287,8 +287,14 @@ impl Cdt {
                 Target::Face(f, _) => match self.face_split(f, m) {
                     FaceSplit::At => self.remember_refusal(m, |c| c.split_face(f, m))?,
                     FaceSplit::Edge(a, b) => {
+                        // That edge already waits below: the splits would go round in
+                        // a cycle.
+                        let edge = Target::Edge(a, b, None);
+                        if stack.contains(&edge) {
+                            return Err(InsertError::Refused(m));
+                        }
                         stack.pop();
-                        stack.push(Target::Edge(a, b, None));
+                        stack.push(edge);
                         continue;
                     }
                 },
@@ -664,10 +670,15 @@ impl Cdt {
             && made.iter().all(|s| self.tets.has_face(s[0], s[1], s[2]))
             && !self.makes_shim(vertex, facets)
             && !self.breaks_facets(vertex);
-        if !ok {
+        let close = ok && self.too_close(vertex);
+        if !ok || close {
             free::take_back(&mut self.tets, settled);
             undo_tables(&mut self.tets);
             return match in_way {
+                _ if close => Err(InsertError::TooClose {
+                    point: m,
+                    floor: self.split_floor,
+                }),
                 Some(g) => Ok(Err(g)),
                 None => Err(InsertError::Refused(m)),
             };
@@ -675,6 +686,25 @@ impl Cdt {
         self.next_pert += 1;
         self.added += 1;
         Ok(Ok(()))
+    }
+
+    /// While refining: whether new vertex `v` has a neighbour nearer than the split
+    /// floor. The cavity's vertices are checked before a split, but the flips that
+    /// settle it can join `v` to vertices beyond it.
+    pub(super) fn too_close(&self, v: VertexId) -> bool {
+        if self.split_floor == 0.0 {
+            return false;
+        }
+        let mut star = Vec::new();
+        self.tets.dt.star(v, &mut star);
+        let p = &self.tets.dt.points[v as usize];
+        star.iter().any(|&t| {
+            self.tets.dt.mesh.verts(t).iter().any(|&x| {
+                x != v
+                    && x != GHOST
+                    && norm(&sub(&self.tets.dt.points[x as usize], p)) < self.split_floor
+            })
+        })
     }
 }
 
