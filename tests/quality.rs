@@ -419,3 +419,20 @@ fn refinement_ends_where_splits_cascade_toward_a_point() {
     // it, and a cascade of splits keeps an eighth of the floor.
     assert!(shortest > 3e-6, "an edge of {shortest}");
 }
+
+#[test]
+fn refinement_ends_where_splits_would_cycle_or_crowd() {
+    // femur.off: a subface split moved to an edge already waiting below it, whose split
+    // asked for that subface again, and the cascade went round until its bound.
+    // boeing.off: the flips settling a split joined its point to vertices nearer than
+    // the floor, and refinement crowded points around them. Both ran for minutes.
+    for name in ["plc/femur.off", "plc/boeing.off"] {
+        let input = fs::read_to_string(example(name)).unwrap();
+        let vertices: usize = input.split_whitespace().nth(1).unwrap().parse().unwrap();
+        let r = refine(&example(name), "-pq1.414");
+        assert!(
+            r.points.len() > vertices,
+            "{name}: refinement added no point"
+        );
+    }
+}
