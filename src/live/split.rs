@@ -133,7 +133,7 @@ pub(super) fn encroached_constraints(
     Encroachment { seg, face, nearest }
 }
 
-/// A subsegment that point `p` encroaches upon, if any (see [`encroached_except`]).
+/// A subsegment that point `p` encroaches upon, if any (see [`encroached_constraints`]).
 pub(super) fn encroached(cdt: &mut Cdt, p: &Point) -> Option<(VertexId, VertexId)> {
     let pert = cdt.next_pert;
     encroached_constraints(&mut cdt.tets, p, pert, None, false).seg
