@@ -215,6 +215,18 @@ impl Search<'_> {
     ) -> bool {
         let mut star = Vec::new();
         cdt.dt.star(v, &mut star);
+        self.covering_face_in(cdt, v, &star, through, kept)
+    }
+
+    /// [`Self::covering_face_around`] with the star of `v` given.
+    pub(crate) fn covering_face_in(
+        &self,
+        cdt: &Cdt,
+        v: VertexId,
+        star: &[crate::mesh::TetId],
+        through: bool,
+        kept: impl Fn(crate::mesh::TetId) -> bool,
+    ) -> bool {
         let mut covered: Vec<(u32, f64)> = Vec::new();
         for &t in star.iter().filter(|&&t| !cdt.is_ghost(t)) {
             for (i, &x) in cdt.dt.mesh.verts(t).iter().enumerate() {

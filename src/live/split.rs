@@ -269,11 +269,15 @@ impl Cdt {
             }
             // While refining, no split comes nearer a vertex than the insertion floor,
             // whatever asked for it (the termination argument, ARCHITECTURE.md).
-            let redirected = match top {
-                Target::Face(f, _) => matches!(self.face_split(f, m), FaceSplit::Edge(..)),
-                Target::Edge(..) => false,
+            // A subface whose circumcentre lies beyond an edge is split at that edge.
+            let redirect = match top {
+                Target::Face(f, _) => match self.face_split(f, m) {
+                    FaceSplit::Edge(a, b) => Some(Target::Edge(a, b, None)),
+                    FaceSplit::At => None,
+                },
+                Target::Edge(..) => None,
             };
-            if nearest < self.split_floor && !redirected {
+            if nearest < self.split_floor && redirect.is_none() {
                 return Err(InsertError::TooClose {
                     point: m,
                     floor: self.split_floor,
@@ -282,22 +286,18 @@ impl Cdt {
             if self.was_refused(&m) {
                 return Err(InsertError::Refused(m));
             }
+            if let Some(edge) = redirect {
+                // That edge already waits below: the splits would go round in a cycle.
+                if stack.contains(&edge) {
+                    return Err(InsertError::Refused(m));
+                }
+                stack.pop();
+                stack.push(edge);
+                continue;
+            }
             let in_way = match top {
                 Target::Edge(a, b, _) => self.remember_refusal(m, |c| c.split_edge(a, b, m))?,
-                Target::Face(f, _) => match self.face_split(f, m) {
-                    FaceSplit::At => self.remember_refusal(m, |c| c.split_face(f, m))?,
-                    FaceSplit::Edge(a, b) => {
-                        // That edge already waits below: the splits would go round in
-                        // a cycle.
-                        let edge = Target::Edge(a, b, None);
-                        if stack.contains(&edge) {
-                            return Err(InsertError::Refused(m));
-                        }
-                        stack.pop();
-                        stack.push(edge);
-                        continue;
-                    }
-                },
+                Target::Face(f, _) => self.remember_refusal(m, |c| c.split_face(f, m))?,
             };
             if let Some(g) = in_way {
                 let t = Target::Face(g, None);
@@ -774,31 +774,28 @@ impl Cdt {
             index: Default::default(),
             shared: Some(index),
         };
+        let mut star = Vec::new();
+        self.tets.dt.star(v, &mut star);
         // Faces of the exterior (a layer of flat tets between a facet that is not flat
         // and the hull) are carved away with it.
         let inside = |t: TetId| !self.reaches_hull(t);
-        if search.covering_face_around(&self.tets, v, true, inside)
-            || search.covering_face_around(&self.tets, v, false, inside)
+        if search.covering_face_in(&self.tets, v, &star, true, inside)
+            || search.covering_face_in(&self.tets, v, &star, false, inside)
         {
             return true;
         }
-        let mut star = Vec::new();
-        self.tets.dt.star(v, &mut star);
         let dt = &self.tets.dt;
-        let shims: Vec<TetId> = star
-            .into_iter()
-            .filter(|&t| {
-                let w = dt.mesh.verts(t);
-                !w.contains(&GHOST)
-                    && index
-                        .shim_facet(
-                            &w.map(|x| dt.points[x as usize]),
-                            w.map(|x| dt.orig[x as usize]),
-                        )
-                        .is_some()
-            })
-            .collect();
-        shims.into_iter().any(|t| !self.reaches_hull(t))
+        star.iter().any(|&t| {
+            let w = dt.mesh.verts(t);
+            !w.contains(&GHOST)
+                && index
+                    .shim_facet(
+                        &w.map(|x| dt.points[x as usize]),
+                        w.map(|x| dt.orig[x as usize]),
+                    )
+                    .is_some()
+                && inside(t)
+        })
     }
 
     /// Whether tet `t` reaches the hull through faces that are no subfaces, within
